@@ -1,0 +1,3 @@
+from mechc.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,57 @@
+"""The cell protocol: what a library cell declares so the compiler can use it.
+
+A cell is a small class in a file under ``stdlib/`` (or a directory given with ``--cells`` or
+``MECHC_CELLS``); ``mechc cells`` lists it without any change to the compiler. See
+docs/write-a-cell.md.
+"""
+
+from __future__ import annotations
+
+import string
+from dataclasses import dataclass
+from typing import ClassVar
+
+
+@dataclass(frozen=True)
+class Pin:
+    name: str
+    kind: str = "translating"  # or "rotating"
+    direction: str = "in"  # "in" | "out"
+
+
+class Cell:
+    """Base class of library cells.
+
+    Class attributes a subclass sets:
+
+    - ``name``: unique library name (lower case), the ``cell`` field of netlist cells;
+    - ``type``: the logic type it realises (``mechc.netlist.types.TYPES``);
+    - ``min_inputs`` / ``max_inputs``: how many input pins it can have (fan-in);
+    - ``pin_kind``: ``"translating"`` or ``"rotating"`` terminals;
+    - ``outputs``: output pin names;
+    - ``description``: one line for ``mechc cells``.
+    """
+
+    name: ClassVar[str] = ""
+    type: ClassVar[str] = ""
+    min_inputs: ClassVar[int] = 2
+    max_inputs: ClassVar[int] = 2
+    outputs: ClassVar[tuple[str, ...]] = ("Z",)
+    pin_kind: ClassVar[str] = "translating"
+    description: ClassVar[str] = ""
+    source: ClassVar[str] = ""  # set by the library loader: file the cell came from
+
+    @classmethod
+    def input_names(cls, n: int) -> list[str]:
+        """Input pin names for an instance with ``n`` inputs (A, B, C, ... by default)."""
+        return list(string.ascii_uppercase[:n])
+
+    @classmethod
+    def pins(cls, n: int) -> list[Pin]:
+        return ([Pin(p, cls.pin_kind, "in") for p in cls.input_names(n)]
+                + [Pin(p, cls.pin_kind, "out") for p in cls.outputs])
+
+    @classmethod
+    def cost(cls, n_inputs: int) -> int:
+        """Parts count (bodies + springs) of an instance; the mapper minimises the sum."""
+        raise NotImplementedError

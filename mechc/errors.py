@@ -1,0 +1,34 @@
+"""Errors a user can cause, each with an exit status and a one-line message.
+
+The CLI catches :class:`MechcError` and prints ``str(err)``; anything else is a bug in mechc and
+is reported as such (still without dumping a traceback unless ``MECHC_DEBUG`` is set).
+"""
+
+from __future__ import annotations
+
+EXIT_OK = 0
+EXIT_FAILED = 1  # a proof or design check failed
+EXIT_USAGE = 2  # bad input: spec syntax, unknown file, inconsistent options
+EXIT_INTERNAL = 3
+
+
+class MechcError(Exception):
+    exit_code = EXIT_USAGE
+
+
+class SpecError(MechcError):
+    """A problem in an input file, located by file, line and column (1-based)."""
+
+    def __init__(self, path: str, line: int, col: int, message: str):
+        self.path, self.line, self.col, self.message = path, line, col, message
+        super().__init__(f"{path}:{line}:{col}: error: {message}")
+
+
+class UsageError(MechcError):
+    """Bad command-line use or an unreadable/invalid file that has no line to point at."""
+
+
+class DesignError(MechcError):
+    """The design cannot be built as asked (e.g. a failed design check)."""
+
+    exit_code = EXIT_FAILED

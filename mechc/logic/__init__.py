@@ -1,0 +1,1 @@
+"""Two-level logic: cubes, truth tables, prime implicants, exact covers."""

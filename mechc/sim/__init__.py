@@ -1,0 +1,1 @@
+"""Proofs of a design against a spec: logic, kinematic and dynamic levels."""

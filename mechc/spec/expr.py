@@ -1,0 +1,169 @@
+"""Boolean expressions: the small AST shared by specs, equations and printing.
+
+Grammar (loosest first): ``or := xor ('|' xor)*``, ``xor := and ('^' and)*``,
+``and := unary ('&' unary)*``, ``unary := '~' unary | NAME | '0' | '1' | '(' or ')'``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechc.spec.lexer import Token, TokenStream
+
+
+@dataclass(frozen=True)
+class Var:
+    name: str
+
+
+@dataclass(frozen=True)
+class Const:
+    value: bool
+
+
+@dataclass(frozen=True)
+class Not:
+    arg: Expr
+
+
+@dataclass(frozen=True)
+class And:
+    args: tuple[Expr, ...]
+
+
+@dataclass(frozen=True)
+class Or:
+    args: tuple[Expr, ...]
+
+
+@dataclass(frozen=True)
+class Xor:
+    args: tuple[Expr, ...]
+
+
+Expr = Var | Const | Not | And | Or | Xor
+
+
+def parse_expr(ts: TokenStream, resolve: Callable[[Token], None]) -> Expr:
+    """Parse an expression; ``resolve`` is called on every name (it raises for unknown ones)."""
+    return _parse_or(ts, resolve)
+
+
+def _parse_binary(ts, resolve, op, node, sub):
+    args = [sub(ts, resolve)]
+    while ts.at_op(op):
+        ts.advance()
+        while ts.cur.kind == "NEWLINE":  # an operator at line end continues the expression
+            ts.advance()
+        args.append(sub(ts, resolve))
+    return args[0] if len(args) == 1 else node(tuple(args))
+
+
+def _parse_or(ts, resolve):
+    return _parse_binary(ts, resolve, "|", Or, _parse_xor)
+
+
+def _parse_xor(ts, resolve):
+    return _parse_binary(ts, resolve, "^", Xor, _parse_and)
+
+
+def _parse_and(ts, resolve):
+    return _parse_binary(ts, resolve, "&", And, _parse_unary)
+
+
+def _parse_unary(ts: TokenStream, resolve) -> Expr:
+    t = ts.cur
+    if t.kind == "OP" and t.text == "~":
+        ts.advance()
+        return Not(_parse_unary(ts, resolve))
+    if t.kind == "OP" and t.text == "(":
+        ts.advance()
+        e = _parse_or(ts, resolve)
+        if not ts.at_op(")"):
+            raise ts.error(f"expected ')' to close the '(' at line {t.line} column {t.col}, "
+                           f"found {ts.describe()}")
+        ts.advance()
+        return e
+    if t.kind == "NAME":
+        resolve(t)
+        ts.advance()
+        return Var(t.text)
+    if t.kind == "NUMBER" and t.text in ("0", "1"):
+        ts.advance()
+        return Const(t.text == "1")
+    raise ts.error(f"expected a name, '~', '(' or a constant 0/1, found {ts.describe()}")
+
+
+def evaluate(e: Expr, env: Mapping[str, np.ndarray], size: int) -> np.ndarray:
+    """Vectorised evaluation: ``env`` maps names to boolean arrays of length ``size``."""
+    if isinstance(e, Var):
+        return env[e.name]
+    if isinstance(e, Const):
+        return np.full(size, e.value, dtype=bool)
+    if isinstance(e, Not):
+        return ~evaluate(e.arg, env, size)
+    vals = [evaluate(a, env, size) for a in e.args]
+    out = vals[0].copy()
+    for v in vals[1:]:
+        if isinstance(e, And):
+            out &= v
+        elif isinstance(e, Or):
+            out |= v
+        else:
+            out ^= v
+    return out
+
+
+_PREC = {Or: 1, Xor: 2, And: 3}
+_SYM = {Or: " | ", Xor: " ^ ", And: " & "}
+
+
+def to_text(e: Expr, parent: int = 0) -> str:
+    """Print in the .bool syntax with the fewest parentheses (the text re-parses to ``e``)."""
+    if isinstance(e, Var):
+        return e.name
+    if isinstance(e, Const):
+        return "1" if e.value else "0"
+    if isinstance(e, Not):
+        return "~" + to_text(e.arg, 4)
+    prec = _PREC[type(e)]
+    s = _SYM[type(e)].join(to_text(a, prec) for a in e.args)
+    return f"({s})" if prec < parent else s
+
+
+def names(e: Expr) -> set[str]:
+    if isinstance(e, Var):
+        return {e.name}
+    if isinstance(e, Const):
+        return set()
+    if isinstance(e, Not):
+        return names(e.arg)
+    return set().union(*(names(a) for a in e.args))
+
+
+def to_sympy(e: Expr, symbols: Mapping[str, object]):
+    """The same expression in sympy (for equivalence checks and pretty printing)."""
+    import sympy
+
+    if isinstance(e, Var):
+        return symbols[e.name]
+    if isinstance(e, Const):
+        return sympy.true if e.value else sympy.false
+    if isinstance(e, Not):
+        return sympy.Not(to_sympy(e.arg, symbols))
+    args = [to_sympy(a, symbols) for a in e.args]
+    return {And: sympy.And, Or: sympy.Or, Xor: sympy.Xor}[type(e)](*args)
+
+
+def sop(terms: Sequence[Sequence[tuple[str, bool]]]) -> Expr:
+    """Sum of products from ``[[(name, positive), ...], ...]``; empty sum is 0, empty term 1."""
+    prods: list[Expr] = []
+    for term in terms:
+        lits = [Var(n) if pos else Not(Var(n)) for n, pos in term]
+        prods.append(Const(True) if not lits else lits[0] if len(lits) == 1 else And(tuple(lits)))
+    if not prods:
+        return Const(False)
+    return prods[0] if len(prods) == 1 else Or(tuple(prods))

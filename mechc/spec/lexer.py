@@ -1,0 +1,152 @@
+"""Tokeniser shared by the text front ends (.bool, .fsm).
+
+Every token carries its 1-based line and column so every error can point at the text.
+Newlines are tokens (statements end at a newline) except inside parentheses.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from mechc.errors import SpecError
+
+MAX_SPEC_BYTES = 50_000_000
+
+
+@dataclass(frozen=True)
+class Token:
+    kind: str  # NAME NUMBER OP NEWLINE EOF
+    text: str
+    line: int
+    col: int
+
+
+_TOKEN_RE = re.compile(
+    r"(?P<ws>[ \t\r\f]+)|(?P<comment>#[^\n]*)|(?P<nl>\n)"
+    r"|(?P<name>[A-Za-z_][A-Za-z0-9_]*)|(?P<number>[0-9]+)"
+    r"|(?P<op>[~&|^()=,:\-\[\]])"
+)
+
+
+def read_text(path: str | Path) -> str:
+    """Read a spec file as UTF-8 text, turning every I/O or encoding problem into a SpecError."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise SpecError(str(path), 1, 1, "file not found") from None
+    except IsADirectoryError:
+        raise SpecError(str(path), 1, 1, "is a directory, expected a spec file") from None
+    except OSError as e:
+        raise SpecError(str(path), 1, 1, f"cannot read file: {e.strerror}") from None
+    if len(data) > MAX_SPEC_BYTES:
+        raise SpecError(str(path), 1, 1, f"file is {len(data)} bytes; the limit is "
+                        f"{MAX_SPEC_BYTES}")
+    nul = data.find(b"\0")
+    if nul >= 0:
+        line, col = _position(data, nul)
+        raise SpecError(str(path), line, col, "binary data (NUL byte): expected a text spec")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line, col = _position(data, e.start)
+        raise SpecError(str(path), line, col,
+                        f"invalid UTF-8 byte 0x{data[e.start]:02x}: expected a text spec") from None
+    return text.lstrip("\ufeff")
+
+
+def _position(data: bytes, offset: int) -> tuple[int, int]:
+    line = data.count(b"\n", 0, offset) + 1
+    col = offset - (data.rfind(b"\n", 0, offset) + 1) + 1
+    return line, col
+
+
+def tokenize(text: str, path: str) -> list[Token]:
+    tokens: list[Token] = []
+    line, line_start, pos, depth = 1, 0, 0, 0
+    while pos < len(text):
+        m = _TOKEN_RE.match(text, pos)
+        col = pos - line_start + 1
+        if not m:
+            ch = text[pos]
+            shown = repr(ch) if ch.isprintable() else f"U+{ord(ch):04X}"
+            raise SpecError(path, line, col, f"unexpected character {shown}")
+        kind = m.lastgroup
+        s = m.group()
+        if kind == "nl":
+            if depth == 0:
+                tokens.append(Token("NEWLINE", "\n", line, col))
+            line += 1
+            line_start = m.end()
+        elif kind == "name":
+            tokens.append(Token("NAME", s, line, col))
+        elif kind == "number":
+            tokens.append(Token("NUMBER", s, line, col))
+        elif kind == "op":
+            if s == "(":
+                depth += 1
+            elif s == ")":
+                depth = max(0, depth - 1)
+            tokens.append(Token("OP", s, line, col))
+        pos = m.end()
+    tokens.append(Token("NEWLINE", "\n", line, pos - line_start + 1))
+    tokens.append(Token("EOF", "", line, pos - line_start + 1))
+    return tokens
+
+
+class TokenStream:
+    """Cursor over tokens with helpers that raise located errors."""
+
+    def __init__(self, tokens: list[Token], path: str):
+        self.toks, self.i, self.path = tokens, 0, path
+
+    @property
+    def cur(self) -> Token:
+        return self.toks[self.i]
+
+    def peek(self, k: int = 1) -> Token:
+        return self.toks[min(self.i + k, len(self.toks) - 1)]
+
+    def advance(self) -> Token:
+        t = self.toks[self.i]
+        if t.kind != "EOF":
+            self.i += 1
+        return t
+
+    def error(self, message: str, tok: Token | None = None) -> SpecError:
+        t = tok or self.cur
+        return SpecError(self.path, t.line, t.col, message)
+
+    def describe(self, tok: Token | None = None) -> str:
+        t = tok or self.cur
+        if t.kind == "NEWLINE":
+            return "end of line"
+        if t.kind == "EOF":
+            return "end of file"
+        return repr(t.text)
+
+    def expect_op(self, op: str, what: str | None = None) -> Token:
+        if self.cur.kind == "OP" and self.cur.text == op:
+            return self.advance()
+        raise self.error(f"expected {what or repr(op)}, found {self.describe()}")
+
+    def expect_name(self, what: str = "a name") -> Token:
+        if self.cur.kind == "NAME":
+            return self.advance()
+        raise self.error(f"expected {what}, found {self.describe()}")
+
+    def expect_newline(self) -> None:
+        if self.cur.kind in ("NEWLINE", "EOF"):
+            if self.cur.kind == "NEWLINE":
+                self.advance()
+            return
+        raise self.error(f"expected end of line, found {self.describe()}")
+
+    def at_op(self, op: str) -> bool:
+        return self.cur.kind == "OP" and self.cur.text == op
+
+    def skip_newlines(self) -> None:
+        while self.cur.kind == "NEWLINE":
+            self.advance()
