@@ -101,7 +101,22 @@ def build_parser() -> argparse.ArgumentParser:
                    help="extra directory of cell files (repeatable)")
     k.add_argument("--json", action="store_true", help="print as JSON")
     k.set_defaults(func=cmd_cells)
+
+    _register_optional(sub, "mechc.synthesis.cli")  # mechc synth ...
     return p
+
+
+def _register_optional(sub, module: str) -> None:
+    """Subcommands that live with their subsystem: the module defines ``register(sub)``."""
+    import importlib
+
+    try:
+        mod = importlib.import_module(module)
+    except ModuleNotFoundError as e:
+        if e.name and module.startswith(e.name):
+            return  # subsystem not present in this build
+        raise
+    mod.register(sub)
 
 
 def _compile_options(c: argparse.ArgumentParser) -> None:

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from mechc.netlist.ir import Netlist, in_node
 
 
@@ -85,15 +87,21 @@ def place(nl: Netlist, pitch: tuple[float, float] = (140.0, 90.0), sweeps: int =
 
 
 def _crossings(cols: list[list[str]], preds: dict[str, list[str]]) -> int:
-    """Pairs of edges whose straight segments cross, counted between positions (approximate for
-    edges that skip columns: each is compared by its end rows)."""
+    """Pairs of edges between the same two columns whose straight segments cross."""
     pos = {node: (ci, ri) for ci, col in enumerate(cols) for ri, node in enumerate(col)}
-    edges = [(pos[u], pos[v]) for v in pos for u in preds.get(v, []) if u in pos]
+    groups: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for v, us in preds.items():
+        if v not in pos:
+            continue
+        cv, rv = pos[v]
+        for u in us:
+            if u in pos:
+                cu, ru = pos[u]
+                groups.setdefault((cu, cv), []).append((ru, rv))
     count = 0
-    for i in range(len(edges)):
-        (c1, r1), (c2, r2) = edges[i]
-        for j in range(i + 1, len(edges)):
-            (d1, s1), (d2, s2) = edges[j]
-            if c1 == d1 and c2 == d2 and (r1 - s1) * (r2 - s2) < 0:
-                count += 1
+    for edges in groups.values():
+        e = np.array(edges)
+        d0 = e[:, 0][:, None] - e[:, 0][None, :]
+        d1 = e[:, 1][:, None] - e[:, 1][None, :]
+        count += int(np.triu((d0 * d1) < 0, 1).sum())
     return count

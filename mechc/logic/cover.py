@@ -69,6 +69,64 @@ def greedy_cover(A: sparse.csr_matrix, cost: np.ndarray) -> np.ndarray:
     return np.array(sorted(chosen), dtype=np.int64)
 
 
+def reduce_problem(A: sparse.csr_matrix, cost: np.ndarray):
+    """Shrink a unate covering problem without losing an optimum: select essential columns,
+    drop dominating rows and dominated columns, repeat until nothing changes.
+
+    Returns (forced column indices, remaining row indices, remaining column indices)."""
+    A = sparse.csr_matrix(A, dtype=np.int32)
+    rows = np.arange(A.shape[0])
+    cols = np.arange(A.shape[1])
+    forced: list[int] = []
+    while True:
+        sub = A[rows][:, cols].tocsr()
+        if sub.shape[0] == 0:
+            break
+        changed = False
+        # essential columns: a row only one column covers
+        deg = np.diff(sub.indptr)
+        if (deg == 0).any():
+            raise ValueError("a row no candidate covers")
+        ess = np.unique(sub.indices[sub.indptr[:-1][deg == 1]])
+        if len(ess):
+            forced.extend(cols[ess].tolist())
+            covered = np.asarray(sub[:, ess].sum(axis=1)).ravel() > 0
+            rows = rows[~covered]
+            keep = np.ones(len(cols), dtype=bool)
+            keep[ess] = False
+            cols = cols[keep]
+            continue
+        # row dominance: if row i's columns are a subset of row j's, row j is implied
+        inter = (sub @ sub.T).tocoo()
+        size = deg
+        sub_of = (inter.data == size[inter.row]) & (inter.row != inter.col)
+        i, j = inter.row[sub_of], inter.col[sub_of]
+        # equal rows: drop the later one only
+        drop_rows = set(j[(size[i] < size[j]) | ((size[i] == size[j]) & (i < j))].tolist())
+        if drop_rows:
+            keep = np.array([r not in drop_rows for r in range(len(rows))])
+            rows = rows[keep]
+            changed = True
+        sub = A[rows][:, cols].tocsc()
+        # column dominance: p dominated by q if rows(p) ⊆ rows(q) and cost(q) <= cost(p)
+        csize = np.diff(sub.indptr)
+        empty = csize == 0
+        inter = (sub.T @ sub).tocoo()
+        c = cost[cols]
+        dom = ((inter.data == csize[inter.row]) & (inter.row != inter.col)
+               & (c[inter.col] <= c[inter.row]))
+        p, q = inter.row[dom], inter.col[dom]
+        strict = (csize[p] < csize[q]) | (c[q] < c[p]) | (p > q)
+        drop_cols = set(p[strict].tolist()) | set(np.flatnonzero(empty).tolist())
+        if drop_cols:
+            keep = np.array([k not in drop_cols for k in range(len(cols))])
+            cols = cols[keep]
+            changed = True
+        if not changed:
+            break
+    return np.array(sorted(set(forced)), dtype=np.int64), rows, cols
+
+
 def min_cover(masks: np.ndarray, values: np.ndarray, on_rows: np.ndarray, dc_rows: np.ndarray,
               n: int, time_limit: float, dc_time: float = 2.0) -> CoverResult:
     """Minimum (terms, literals) cover of ``on_rows`` by the candidate cubes; among minimum
@@ -82,13 +140,32 @@ def min_cover(masks: np.ndarray, values: np.ndarray, on_rows: np.ndarray, dc_row
     g = greedy_cover(A, 1.0 + lits / (n + 1.0))
     w_term = n * len(g) + 1  # more than any literal difference between covers of equal size
     c = (w_term + lits).astype(float)
-    res = milp(c, integrality=np.ones(P), bounds=Bounds(0, 1),
-               constraints=[LinearConstraint(A, 1, np.inf)],
-               options={"time_limit": max(0.1, time_limit), "mip_rel_gap": 0.0})
-    if res.x is None:
-        return CoverResult(g, False, "greedy", time.perf_counter() - t0)
-    chosen = np.flatnonzero(res.x > 0.5)
-    proven = res.status == 0
+    forced, rows, cols = reduce_problem(A, c)
+    if len(rows) == 0:
+        chosen, proven = forced, True
+    else:
+        # two stages (fewest terms, then fewest literals with the term count fixed): several
+        # times faster on cyclic random problems than one lexicographic objective
+        sub = A[rows][:, cols]
+        cover_rows = LinearConstraint(sub, 1, np.inf)
+        k = len(cols)
+        ones = np.ones(k)
+
+        def remaining():
+            return max(0.1, time_limit - (time.perf_counter() - t0))
+
+        res = milp(ones, integrality=ones, bounds=Bounds(0, 1), constraints=[cover_rows],
+                   options={"time_limit": remaining()})
+        if res.x is None:
+            return CoverResult(g, False, "greedy", time.perf_counter() - t0)
+        terms = int(round(res.x.sum()))
+        proven = res.status == 0
+        res2 = milp(lits[cols].astype(float), integrality=ones, bounds=Bounds(0, 1),
+                    constraints=[cover_rows, LinearConstraint(ones[None, :], terms, terms)],
+                    options={"time_limit": remaining(), "mip_rel_gap": 0.0})
+        x = res2.x if res2.x is not None else res.x
+        proven = proven and res2.status == 0
+        chosen = np.sort(np.concatenate([forced, cols[x > 0.5]]))
     if proven and len(dc_rows) and P <= DC_TIEBREAK_MAX_CANDIDATES:
         better = _fewest_dc(A, c, float(c[chosen].sum()), masks, values, dc_rows, dc_time)
         if better is not None:

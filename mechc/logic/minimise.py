@@ -27,6 +27,7 @@ class MinimiseOptions:
     prime_limit: int = 20_000  # more primes than this: use the expansion heuristic
     share: bool = True  # share product terms between outputs where that saves cells
     complements: bool = True  # also minimise each output's complement (for the mapper)
+    alt_time_limit: float = 3.0  # seconds per program for those alternatives (never reported)
 
 
 @dataclass
@@ -115,15 +116,16 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
         table = spec.table(name)
         covers[name], prime_sets[name] = _minimise_table(table, n, opts)
         if opts.complements:
-            comps[name], _ = _minimise_table(_complement(table), n, opts)
+            comps[name], _ = _minimise_table(_complement(table), n, _alt(opts))
     eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
     if opts.complements:
         for name in spec.outputs:
-            xf = _xor_form(spec.table(name), spec.inputs, opts)
+            xf = _xor_form(spec.table(name), spec.inputs, _alt(opts))
             if xf is not None:
                 eq.xor_forms[name] = xf
     if opts.share and len(spec.outputs) > 1:
         _share(spec, eq, prime_sets, opts)
+    eq.shared_terms = _count_shared(eq)
     verify(spec, eq)
     return eq
 
@@ -149,6 +151,13 @@ def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
     proven = res.proven and method_note is None
     method = method_note or res.method
     return Cover(cubes, proven, method, time.perf_counter() - t0), (masks, values, on, dc)
+
+
+def _alt(opts: MinimiseOptions) -> MinimiseOptions:
+    """Options for the alternative forms the mapper may try (shorter time limit)."""
+    from dataclasses import replace
+
+    return replace(opts, time_limit=min(opts.time_limit, opts.alt_time_limit))
 
 
 def _complement(table: np.ndarray) -> np.ndarray:
@@ -241,11 +250,16 @@ def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None
     for nm in names:
         old = eq.covers[nm]
         eq.covers[nm] = Cover(new[nm], old.proven, old.method, old.seconds)
-    counts: dict[tuple[int, int], int] = {}
-    for cubes in new.values():
-        for c in cubes:
-            counts[(c.mask, c.value)] = counts.get((c.mask, c.value), 0) + 1
-    eq.shared_terms = sum(1 for v in counts.values() if v > 1)
+
+
+def _count_shared(eq: Equations) -> int:
+    """Product terms (with at least two literals) used by more than one output."""
+    counts: dict[Cube, int] = {}
+    for cover in eq.covers.values():
+        for c in set(cover.cubes):
+            if c.literals() >= 2:
+                counts[c] = counts.get(c, 0) + 1
+    return sum(1 for v in counts.values() if v > 1)
 
 
 class VerificationError(MechcError):

@@ -91,7 +91,7 @@ def tokenize(text: str, path: str) -> list[Token]:
                 depth = max(0, depth - 1)
             tokens.append(Token("OP", s, line, col))
         pos = m.end()
-    tokens.append(Token("NEWLINE", "\n", line, pos - line_start + 1))
+    tokens.append(Token("NEWLINE", "", line, pos - line_start + 1))  # "" marks end of file
     tokens.append(Token("EOF", "", line, pos - line_start + 1))
     return tokens
 
@@ -122,7 +122,7 @@ class TokenStream:
     def describe(self, tok: Token | None = None) -> str:
         t = tok or self.cur
         if t.kind == "NEWLINE":
-            return "end of line"
+            return "end of line" if t.text else "end of file"
         if t.kind == "EOF":
             return "end of file"
         return repr(t.text)

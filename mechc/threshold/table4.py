@@ -1,0 +1,171 @@
+"""Table IV of 001 (weight-threshold and threshold-angle vectors for FV 0..127) by program, and its
+comparison with the scanned table.
+
+    python -m mechc.threshold.table4 > docs/threshold-table4.md
+
+Thresholds are listed as in the dissertation: T1 > T2 > ..., the positions of the crossings.
+The threshold-angle vector names the separation angle of each crossing (tau_a for the step from
+the lowest sum to the next, Fig. 29) with superscript 01 where the output rises and 10 where it
+falls as the sum grows.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mechc.threshold.functions import truth_table_from_fv
+from mechc.threshold.seed_tables import TABLE_IV
+from mechc.threshold.weights import Realisation, realise, static_hazards, thresholds_for
+
+LETTERS = "abcdefghijklmnopqrstuvwxyz"
+
+
+def tau_vector(r: Realisation) -> tuple[str, ...]:
+    """Threshold-angle vector, ascending: ("a10", "d01") etc."""
+    out = []
+    value = r.below
+    for g in r.gaps():
+        out.append(f"{LETTERS[g]}{value}{1 - value}")
+        value = 1 - value
+    return tuple(out)
+
+
+def fmt_t(x: float) -> str:
+    return f"{x:.1f}"
+
+
+@dataclass
+class ScanComparison:
+    fv: int
+    ours: Realisation
+    scan_weights: tuple[int, ...] | None
+    scan_thresholds: tuple[float, ...]
+    scan_tau: tuple[str, ...]
+    verdict: str  # "agrees", "equally valid", "OCR", "error", "unreadable"
+    detail: str
+
+
+def _valid(weights, printed: tuple[float, ...], tt) -> tuple[bool, tuple[float, ...] | None]:
+    """Do these weights realise tt with exactly the printed threshold positions?"""
+    res = thresholds_for(weights, tt)
+    if res is None:
+        return False, None
+    th, _ = res
+    return sorted(printed) == sorted(th), th
+
+
+def _tau_from(weights, th, tt) -> tuple[str, ...]:
+    below = thresholds_for(weights, tt)[1]
+    return tau_vector(Realisation(tuple(weights), tuple(sorted(th)), below))
+
+
+def _tau_agrees(printed: tuple[str, ...], computed: tuple[str, ...]) -> list[str]:
+    """Readable printed letters/superscripts that disagree with the computed vector."""
+    bad = []
+    comp = sorted(computed)
+    for p in printed:
+        letter, sup = p[:1], p[1:]
+        if letter != "?" and not any(c[0] == letter for c in comp):
+            bad.append(f"tau_{letter} printed, computed {', '.join('tau_' + c for c in comp)}")
+        elif letter != "?" and sup in ("01", "10"):
+            match = [c for c in comp if c[0] == letter]
+            if match and match[0][1:] != sup:
+                bad.append(f"tau_{letter}^{sup} printed, computed tau_{match[0]}")
+    return bad
+
+
+def compare_scan(fv: int) -> ScanComparison:
+    tt = truth_table_from_fv(fv)
+    ours = realise(fv)
+    w, printed_t, printed_tau, note = TABLE_IV[fv]
+    pt = tuple(t for t in printed_t if t is not None)
+    if w is None:
+        return ScanComparison(fv, ours, None, pt, printed_tau, "unreadable", note)
+    ok, th = _valid(w, pt, tt)
+    size = sum(abs(v) for v in w)
+    if ok:
+        tau_bad = _tau_agrees(printed_tau, _tau_from(w, th, tt))
+        if len(th) > ours.k or size > ours.size:
+            verdict, detail = "error", f"not minimal: k={len(th)}, size={size}"
+        elif tuple(w) == ours.weights:
+            verdict, detail = "agrees", ""
+        else:
+            verdict, detail = "equally valid", f"same k={len(th)} and size={size}"
+        if tau_bad:
+            verdict = "OCR" if verdict in ("agrees", "equally valid") else verdict
+            detail = "; ".join([d for d in (detail, *tau_bad) if d])
+        return ScanComparison(fv, ours, tuple(w), pt, printed_tau, verdict,
+                              "; ".join(d for d in (detail, note) if d))
+    # single-character repairs: a lost or spurious minus sign on one threshold or weight
+    repairs = []
+    for i in range(len(pt)):
+        t2 = tuple(-t if q == i else t for q, t in enumerate(pt))
+        if _valid(w, t2, tt)[0]:
+            repairs.append(f"threshold {fmt_t(pt[i])} -> {fmt_t(-pt[i])}")
+    for i in range(len(w)):
+        w2 = tuple(-v if q == i else v for q, v in enumerate(w))
+        if _valid(w2, pt, tt)[0]:
+            repairs.append(f"w{i + 1} {w[i]} -> {-w[i]}")
+    if repairs:
+        return ScanComparison(fv, ours, tuple(w), pt, printed_tau, "OCR",
+                              "minus sign: " + " or ".join(repairs) + (f"; {note}" if note else ""))
+    if th is None:
+        why = "printed weights give equal sums to minterms with different outputs"
+    else:
+        why = (f"printed thresholds {', '.join(map(fmt_t, sorted(pt, reverse=True)))}; "
+               f"these weights need {', '.join(map(fmt_t, sorted(th, reverse=True)))}")
+    return ScanComparison(fv, ours, tuple(w), pt, printed_tau, "error",
+                          why + (f"; {note}" if note else ""))
+
+
+def markdown() -> str:
+    lines = [
+        "# Table IV by program: weight-threshold vectors vs function values",
+        "",
+        "Generated by `python -m mechc.threshold.table4`; do not edit. FV numbering of 001",
+        "§3.7.1 (minterm x̄1x̄2x̄3 is the most significant bit); FV > 127 uses 255 − FV with the",
+        "output inverted. Weights minimise the number of thresholds k, then Σ|w| (the",
+        "dissertation's k of Eq. 3.12), then static hazards, max|w|, negative weights. Thresholds",
+        "are listed T1 > T2 > … as in the dissertation; `below` is the output below the lowest",
+        "threshold. `hazards` counts single-input changes on which no threshold generator can hold",
+        "its output (see docs/threshold.md). The last columns compare with the scanned table;",
+        "docs/threshold.md explains every row that is not `agrees`.",
+        "",
+        "| FV | W | T | below | τ | k | Σ\\|w\\| | hazards | scan W;T | scan vs computed |",
+        "|---:|---|---|:-:|---|:-:|:-:|:-:|---|---|",
+    ]
+    for fv in range(128):
+        r = realise(fv)
+        tt = truth_table_from_fv(fv)
+        c = compare_scan(fv)
+        w = ", ".join(str(v) for v in r.weights)
+        t = ", ".join(fmt_t(x) for x in sorted(r.thresholds, reverse=True)) or "–"
+        tau = ", ".join(f"τ{x[0]}^{x[1:]}" for x in sorted(tau_vector(r))) or "–"
+        if c.scan_weights is None:
+            scan = "(lost)"
+        else:
+            scan = (", ".join(str(v) for v in c.scan_weights) + "; "
+                    + (", ".join(fmt_t(x) for x in sorted(c.scan_thresholds, reverse=True))
+                       or "–"))
+        verdict = c.verdict if c.verdict in ("agrees", "equally valid") else (
+            f"{c.verdict}: {c.detail}")
+        lines.append(f"| {fv} | {w} | {t} | {r.below} | {tau} | {r.k} | {r.size} | "
+                     f"{len(static_hazards(r.weights, tt))} | {scan} | {verdict} |")
+    return "\n".join(lines) + "\n"
+
+
+def summary() -> dict[str, list[int]]:
+    out: dict[str, list[int]] = {}
+    for fv in range(128):
+        out.setdefault(compare_scan(fv).verdict, []).append(fv)
+    return out
+
+
+def main() -> None:
+    print(markdown(), end="")
+
+
+if __name__ == "__main__":
+    main()
+
+__all__ = ["ScanComparison", "compare_scan", "markdown", "summary", "tau_vector"]

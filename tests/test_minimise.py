@@ -1,0 +1,172 @@
+"""The exact minimiser: primes against brute force, covers against brute force and sympy."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+import sympy
+from sympy.logic import SOPform
+
+from mechc.logic.cubes import DC, Cube, eval_cover
+from mechc.logic.minimise import MinimiseOptions, minimise
+from mechc.logic.primes import prime_implicants
+from mechc.spec.boolfile import parse_bool
+from mechc.spec.model import OutputSpec, Spec
+from tests.helpers import random_table
+
+
+def spec_from_tables(tables: dict[str, np.ndarray], n: int) -> Spec:
+    inputs = [f"x{i}" for i in range(n)]
+    funcs = {}
+    for name, t in tables.items():
+        funcs[name] = OutputSpec(name, on=[Cube.minterm(int(m), n) for m in np.flatnonzero(t == 1)],
+                                 dc=[Cube.minterm(int(m), n) for m in np.flatnonzero(t == DC)])
+    return Spec("random", "bool", inputs, list(tables), funcs)
+
+
+def brute_primes(region: np.ndarray, n: int) -> set[tuple[int, int]]:
+    """Every cube inside the region, keep those not inside a cube with one literal fewer."""
+    idx = np.arange(1 << n)
+    imps = set()
+    for lits in itertools.product((0, 1, 2), repeat=n):  # 2 = variable absent
+        mask = sum(1 << (n - 1 - k) for k, v in enumerate(lits) if v != 2)
+        val = sum(1 << (n - 1 - k) for k, v in enumerate(lits) if v == 1)
+        if region[(idx & mask) == val].all():
+            imps.add((mask, val))
+    return {(m, v) for m, v in imps
+            if not any((m & ~(1 << b), v & ~(1 << b)) in imps for b in range(n) if m >> b & 1)}
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_primes_match_brute_force(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 6))
+    region = rng.random(1 << n) < rng.random()
+    m, v = prime_implicants(region)
+    assert set(zip(m.tolist(), v.tolist())) == brute_primes(region, n)
+
+
+def brute_min_cost(table: np.ndarray, n: int) -> tuple[int, int]:
+    """Minimum (terms, literals) over all covers by primes, by exhaustive search."""
+    on = np.flatnonzero(table == 1)
+    if len(on) == 0:
+        return (0, 0)
+    primes = sorted(brute_primes(table != 0, n), key=lambda p: bin(p[0]).count("1"))
+    cov = [frozenset(int(x) for x in on if (x & m) == v) for m, v in primes]
+    need = frozenset(int(x) for x in on)
+    for k in range(1, len(primes) + 1):
+        best = None
+        for combo in itertools.combinations(range(len(primes)), k):
+            if frozenset().union(*(cov[i] for i in combo)) >= need:
+                lits = sum(bin(primes[i][0]).count("1") for i in combo)
+                best = lits if best is None else min(best, lits)
+        if best is not None:
+            return (k, best)
+    raise AssertionError
+
+
+@pytest.mark.parametrize("seed", range(25))
+def test_cover_is_minimum_terms_then_literals(seed):
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(2, 5))
+    t = random_table(rng, n, p_on=0.45, p_dc=0.15)
+    eq = minimise(spec_from_tables({"f": t}, n), MinimiseOptions(complements=False))
+    c = eq.covers["f"]
+    assert c.proven
+    assert (c.terms, c.literals) == brute_min_cost(t, n)
+
+
+def sop_cost(expr) -> tuple[int, int]:
+    if expr in (sympy.true, sympy.false):
+        return (0 if expr == sympy.false else 1, 0)
+    terms = expr.args if isinstance(expr, sympy.Or) else (expr,)
+    lits = sum(len(t.args) if isinstance(t, sympy.And) else 1 for t in terms)
+    return len(terms), lits
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_random_specs_equivalent_and_no_worse_than_sopform(seed):
+    """4-10 inputs, 1-4 outputs, with don't-cares: every care row right (checked here by direct
+    evaluation of the printed equation with sympy, independently of mechc's own verifier), and
+    literal counts no worse than sympy's SOPform (run where it is fast: n <= 7)."""
+    rng = np.random.default_rng(1000 + seed)
+    n = int(rng.integers(4, 11))
+    m = int(rng.integers(1, 5))
+    tables = {f"f{j}": random_table(rng, n, p_on=float(rng.uniform(0.1, 0.6)),
+                                    p_dc=float(rng.uniform(0, 0.25))) for j in range(m)}
+    spec = spec_from_tables(tables, n)
+    eq = minimise(spec, MinimiseOptions(time_limit=4, alt_time_limit=1))
+    syms = sympy.symbols(spec.inputs)
+    env = dict(zip(spec.inputs, syms))
+    from mechc.spec import expr as ex
+
+    rows = np.arange(1 << n)
+    for name, t in tables.items():
+        care = t != DC
+        got = eval_cover(eq.covers[name].cubes, rows)
+        assert (got[care] == (t[care] == 1)).all()
+        # the printed equation means the same thing (sympy evaluation on a sample of rows)
+        f = sympy.lambdify(syms, ex.to_sympy(eq.expr(name), env), "numpy")
+        sample = rows[care][:64]
+        bits = [((sample >> (n - 1 - k)) & 1).astype(bool) for k in range(n)]
+        vals = np.broadcast_to(np.asarray(f(*bits), dtype=bool), sample.shape)
+        assert (vals == (t[sample] == 1)).all()
+        if n <= 7:
+            on = [list(map(int, format(int(x), f"0{n}b"))) for x in np.flatnonzero(t == 1)]
+            dc = [list(map(int, format(int(x), f"0{n}b"))) for x in np.flatnonzero(t == DC)]
+            ref = SOPform(syms, on, dc)
+            c = eq.covers[name]
+            if c.proven:
+                assert (c.terms, c.literals) <= sop_cost(ref)
+                assert c.literals <= sop_cost(ref)[1] or c.terms < sop_cost(ref)[0]
+
+
+def test_sorter_minimum_is_the_dissertations_equation():
+    spec = parse_bool(open("examples/sorter.bool").read(), "sorter.bool")
+    eq = minimise(spec)
+    rows = np.arange(16)
+    got = eval_cover(eq.covers["Z"].cubes, rows)
+    a, b, c, d = [(rows >> (3 - k)) & 1 for k in range(4)]
+    want = (c & d) | (a & (1 - b) & d) | ((1 - a) & b & c)
+    assert (got == want.astype(bool)).all()  # on all 16 rows, don't-cares included
+    assert eq.covers["Z"].proven and eq.covers["Z"].literals == 8
+
+
+def test_shared_terms_between_outputs():
+    # f = ab + c, g = ab + d: the term ab is prime for both and is shared
+    spec = parse_bool("inputs a b c d\noutputs f g\nf = a & b | c\ng = a & b | d\n")
+    eq = minimise(spec)
+    assert eq.shared_terms == 1
+
+
+def test_constant_functions():
+    spec = parse_bool("inputs a b\noutputs z o\nz = minterms()\no = minterms(0,1,2,3)\n")
+    eq = minimise(spec)
+    assert eq.covers["z"].cubes == []
+    assert eq.covers["o"].cubes == [Cube(0, 0)]
+
+
+def test_time_limit_reports_not_proven():
+    rng = np.random.default_rng(7)
+    t = random_table(rng, 12, p_on=0.45, p_dc=0.1)
+    eq = minimise(spec_from_tables({"f": t}, 12), MinimiseOptions(time_limit=0.2,
+                                                                   complements=False))
+    c = eq.covers["f"]
+    assert not c.proven
+    rows = np.arange(1 << 12)
+    care = t != DC
+    assert (eval_cover(c.cubes, rows)[care] == (t[care] == 1)).all()
+
+
+def test_too_many_primes_falls_back_to_expansion_and_stays_correct():
+    rng = np.random.default_rng(3)
+    t = random_table(rng, 10, p_on=0.5, p_dc=0.1)
+    eq = minimise(spec_from_tables({"f": t}, 10), MinimiseOptions(prime_limit=50,
+                                                                   complements=False))
+    c = eq.covers["f"]
+    assert c.method == "expand" and not c.proven
+    rows = np.arange(1 << 10)
+    care = t != DC
+    assert (eval_cover(c.cubes, rows)[care] == (t[care] == 1)).all()
