@@ -67,6 +67,32 @@ class Spec:
             table[cube_table(f.dc, n)] = DC
         return table
 
+    def values_at(self, bits: np.ndarray) -> dict[str, np.ndarray]:
+        """Spec value (0, 1 or DC) of every output at input vectors given as a boolean
+        (n, N) matrix (row k = input k). Uses the truth table up to MAX_TABLE_INPUTS inputs and
+        the cubes beyond (any number of inputs)."""
+        n = self.n
+        if n <= MAX_TABLE_INPUTS:
+            w = (1 << np.arange(n - 1, -1, -1, dtype=np.int64))
+            rows = (bits.astype(np.int64) * w[:, None]).sum(axis=0)
+            return {o: self.table(o)[rows] for o in self.outputs}
+        out = {}
+        for o in self.outputs:
+            f = self.functions[o]
+            if f.expr is not None:
+                env = {name: bits[k] for k, name in enumerate(self.inputs)}
+                on = ex.evaluate(f.expr, env, bits.shape[1])
+            else:
+                on = _in_cubes(f.on, bits, n)
+            v = np.full(bits.shape[1], f.rest, dtype=np.int8)
+            if f.off:
+                v[_in_cubes(f.off, bits, n)] = 0
+            v[on] = 1
+            if f.dc:
+                v[_in_cubes(f.dc, bits, n)] = DC
+            out[o] = v
+        return out
+
     # ---- JSON echo: enough to re-prove a compiled design against -------------------------
     def to_json(self) -> dict:
         funcs = {}
@@ -106,3 +132,14 @@ class Spec:
             funcs[name] = f
         return Spec(d.get("source", where), d.get("kind", "bool"), inputs, list(d["outputs"]),
                     funcs)
+
+
+def _in_cubes(cubes: list[Cube], bits: np.ndarray, n: int) -> np.ndarray:
+    """Which columns of ``bits`` lie in the union of ``cubes`` (works for any n)."""
+    hit = np.zeros(bits.shape[1], dtype=bool)
+    for c in cubes:
+        m = np.ones(bits.shape[1], dtype=bool)
+        for k, positive in c.literal_list(n):
+            m &= bits[k] if positive else ~bits[k]
+        hit |= m
+    return hit
