@@ -1,0 +1,294 @@
+"""``mechc draw``: the SVG is valid XML, to scale, shows each state's pose and output values, and
+the command fails cleanly (exit 2, one line, nothing overwritten) on bad input.
+
+References are independent of the drawing code: output values come from the spec's own minterm
+lists and from binary addition; distances come from the design JSON and from rigid-body facts
+(an input or output slider travels one stroke from off to on, a lever pin keeps its radius).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+
+from mechc.draw import SCALE_BAR_MM, draw_svg, parse_state
+from mechc.errors import UsageError
+from mechc.pipeline import compile_spec
+from mechc.spec import load_spec
+from mechc.writer import design_to_json, dumps
+from tests.helpers import EXAMPLES
+
+NS = "{http://www.w3.org/2000/svg}"
+
+# examples/sorter.bool: A is the most significant bit of A B C D
+SORTER_ON = {3, 6, 9, 15}
+SORTER_DC = {4, 7, 8, 11}
+
+
+@pytest.fixture(scope="module")
+def sorter():
+    return compile_spec(load_spec(str(EXAMPLES / "sorter.bool")))
+
+
+@pytest.fixture(scope="module")
+def adder():
+    return compile_spec(load_spec(str(EXAMPLES / "full_adder.bool")))
+
+
+@pytest.fixture
+def sorter_json(sorter, tmp_path):
+    p = tmp_path / "sorter.json"
+    p.write_text(dumps(design_to_json(sorter)))
+    return p
+
+
+def _state(names, m):
+    n = len(names)
+    return {k: (m >> (n - 1 - i)) & 1 for i, k in enumerate(names)}
+
+
+def _outputs(svg: str) -> dict[str, int]:
+    """Output values as the drawing's labels state them."""
+    root = ET.fromstring(svg)
+    out = {}
+    for t in root.iter(f"{NS}text"):
+        m = re.fullmatch(r"(\w+) = ([01]) \((on|off)\)", (t.text or "").strip())
+        if m and "halo" not in t.get("class", ""):
+            assert (m.group(2) == "1") == (m.group(3) == "on")
+            out[m.group(1)] = int(m.group(2))
+    return out
+
+
+def _body_polys(svg: str, body: str) -> list[np.ndarray]:
+    """Polygons (px) of a body's own outline (not the fan-out bars added to it)."""
+    root = ET.fromstring(svg)
+    for g in root.iter(f"{NS}g"):
+        if g.get("data-body") == body and g.get("class") != "cn":
+            d = next(p for p in g if p.get("class") == "f").get("d")
+            return [np.array([[float(v) for v in xy.split(",")] for xy in sub.split("L")])
+                    for sub in re.findall(r"M([^MZ]+)Z", d)]
+    raise AssertionError(f"body {body} not drawn")
+
+
+def _cell_box(svg: str, cid: str) -> tuple[str, ...]:
+    r = next(r for r in ET.fromstring(svg).iter(f"{NS}rect") if r.get("data-cell") == cid)
+    return tuple(r.get(k) for k in ("x", "y", "width", "height"))
+
+
+def _circle(svg: str, cls: str, key: str, value: str) -> np.ndarray:
+    root = ET.fromstring(svg)
+    for c in root.iter(f"{NS}circle"):
+        if c.get("class") == cls and c.get(key) == value:
+            return np.array([float(c.get("cx")), float(c.get("cy"))])
+    raise AssertionError(f"no {cls} circle for {value}")
+
+
+def test_valid_xml_and_every_body_drawn(sorter, adder):
+    for design in (sorter, adder):
+        for m in (0, (1 << len(design.netlist.inputs)) - 1):
+            svg = draw_svg(design, _state(design.netlist.inputs, m))
+            root = ET.fromstring(svg)
+            assert root.tag == f"{NS}svg"
+            assert float(root.get("width")) > 0 and float(root.get("height")) > 0
+            drawn = {g.get("data-body") for g in root.iter(f"{NS}g") if g.get("data-body")}
+            assert drawn == set(design.mechanism.body_index())
+            cells = {r.get("data-cell") for r in root.iter(f"{NS}rect") if r.get("data-cell")}
+            assert cells == set(design.netlist.cells)
+            assert len(svg) < 200_000  # a few dozen parts: tens of KB, not megabytes
+
+
+def test_sorter_outputs_match_spec_in_every_state(sorter):
+    for m in range(16):
+        if m in SORTER_DC:
+            continue
+        svg = draw_svg(sorter, _state(["A", "B", "C", "D"], m))
+        assert _outputs(svg) == {"Z": int(m in SORTER_ON)}, m
+
+
+def test_full_adder_outputs_are_binary_sum(adder):
+    names = list(adder.netlist.inputs)
+    for m in range(8):
+        st = _state(names, m)
+        total = st["a"] + st["b"] + st["cin"]
+        assert _outputs(draw_svg(adder, st)) == {"s": total & 1, "cout": total >> 1}
+
+
+def test_state_change_moves_output_by_one_stroke(sorter):
+    scale = 2.0
+    S = sorter.mechanism.ctx.stroke
+    off = draw_svg(sorter, {}, scale)
+    on = draw_svg(sorter, {"C": 1, "D": 1}, scale)  # minterm 3 = 0011: Z on (sorter.bool)
+    assert off != on
+    assert _outputs(off) == {"Z": 0} and _outputs(on) == {"Z": 1}
+    # ground does not move: the two drawings share one frame (pivots, cell boxes)
+    for cid in sorter.netlist.cells:
+        assert _cell_box(off, cid) == _cell_box(on, cid)
+    owner, pin = sorter.mechanism.outputs["Z"]
+    body = sorter.mechanism.owner_part(owner).terminals[pin].body
+    for b in (body, "in:C.slider", "in:D.slider"):
+        for p0, p1 in zip(_body_polys(off, b), _body_polys(on, b)):
+            # off -> on is one stroke to the right (SVG x) and no vertical motion; 0.1 px rounding
+            assert np.allclose(p1[:, 0] - p0[:, 0], S * scale, atol=0.11), b
+            assert np.allclose(p1[:, 1], p0[:, 1], atol=0.11), b
+    # inputs not named stay put
+    for p0, p1 in zip(_body_polys(off, "in:A.slider"), _body_polys(on, "in:A.slider")):
+        assert np.allclose(p0, p1)
+
+
+@pytest.mark.parametrize("scale", [1.0, 2.0, 3.5])
+def test_scale_bar_and_geometry_to_scale(sorter, scale):
+    svg = draw_svg(sorter, {}, scale)
+    bar = ET.fromstring(svg).find(f".//{NS}line[@id='scalebar']")
+    assert float(bar.get("x2")) - float(bar.get("x1")) == pytest.approx(SCALE_BAR_MM * scale,
+                                                                        abs=0.01)
+    # a drawn part has its JSON size times the scale (independent of the bar)
+    body = sorter.mechanism.inputs["A"].bodies[0]
+    mm = np.array(body.outline[0])
+    px = _body_polys(svg, body.id)[0]
+    assert np.ptp(px[:, 0]) == pytest.approx(np.ptp(mm[:, 0]) * scale, abs=0.11)
+    assert np.ptp(px[:, 1]) == pytest.approx(np.ptp(mm[:, 1]) * scale, abs=0.11)
+
+
+def _joint_ends(root, jid: str, tag: str, cls: str) -> tuple[np.ndarray, np.ndarray]:
+    el = next(e for e in root.iter(f"{NS}{tag}") if e.get("data-joint") == jid
+              and e.get("class") == cls)
+    return (np.array([float(el.get("x1")), float(el.get("y1"))]),
+            np.array([float(el.get("x2")), float(el.get("y2"))]))
+
+
+@pytest.mark.parametrize("which", ["sorter", "adder"])
+def test_joints_hold_in_every_state(which, request):
+    """In every drawn state: each rod keeps its length, each groove's pin lies on its slot,
+    and each point pinned to a lever stays at its design distance from the pivot (the lever is
+    rigid). Tolerances cover the 0.1 px rounding of the SVG."""
+    design = request.getfixturevalue(which)
+    scale = 2.0
+    mech = design.mechanism
+    joints = [j for p in mech.all_parts() for j in p.joints if j.kind in ("rod", "groove")]
+    bodies = mech.body_index()
+    assert joints
+    names = list(design.netlist.inputs)
+    for m in range(1 << len(names)):
+        svg = draw_svg(design, _state(names, m), scale)
+        root = ET.fromstring(svg)
+        for j in joints:
+            if j.kind == "rod":
+                a, b = _joint_ends(root, j.id, "line", "rod")
+                assert np.hypot(*(b - a)) == pytest.approx(j.length * scale, abs=0.2), j.id
+                ends = [(j.a, j.pa, a), (j.b, j.pb, b)]
+            else:
+                pin = _circle(svg, "pin", "data-joint", j.id)
+                a, b = _joint_ends(root, j.id, "line", "slo")
+                d = (b - a) / np.hypot(*(b - a))
+                assert abs(np.cross(d, pin - a)) < 0.2, j.id  # on the slot's line
+                assert -0.2 <= np.dot(d, pin - a) <= np.hypot(*(b - a)) + 0.2, j.id
+                ends = [(j.b, j.q, pin)]
+            for bid, design_pt, drawn in ends:
+                lever = bodies.get(bid)
+                if lever is None or lever.kind != "lever":
+                    continue
+                piv = _circle(svg, "pv", "data-body", bid)
+                r_mm = math.hypot(design_pt[0] - lever.pivot[0], design_pt[1] - lever.pivot[1])
+                assert np.hypot(*(drawn - piv)) == pytest.approx(r_mm * scale, abs=0.2), j.id
+
+
+def test_no_labels(sorter):
+    root = ET.fromstring(draw_svg(sorter, {}, labels=False))
+    classes = {t.get("class") for t in root.iter(f"{NS}text")}
+    assert not classes & {"lc", "ln", "li0", "li1", "lo0", "lo1"}
+    assert "tt" in classes  # the title stays
+
+
+@pytest.mark.parametrize("state, word", [({"Q": 1}, "Q"), ({"A": 2}, "A")])
+def test_draw_svg_rejects_bad_state(sorter, state, word):
+    with pytest.raises(UsageError, match=word):
+        draw_svg(sorter, state)
+
+
+def test_parse_state():
+    assert parse_state("A=1, B=off C=on", ["A", "B", "C", "D"]) == {"A": 1, "B": 0, "C": 1,
+                                                                     "D": 0}
+    for bad in ("A", "A=1,A=0", "=1", "E=1", "A=yes"):
+        with pytest.raises(UsageError):
+            parse_state(bad, ["A", "B"])
+
+
+@pytest.mark.parametrize("args, word", [
+    (["--state", "Q=1"], "unknown input 'Q'"),
+    (["--state", "A=2"], "must be 0 or 1"),
+    (["--state", "A"], "expected NAME=0"),
+    (["--scale", "0"], "--scale"),
+])
+def test_cli_bad_input_exit_2_one_line_file_untouched(cli, sorter_json, tmp_path, args, word):
+    out = tmp_path / "out.svg"
+    out.write_text("precious\n")
+    code, stdout, err = cli("draw", sorter_json, "-o", out, *args)
+    assert code == 2
+    assert len(err.strip().splitlines()) == 1 and word in err
+    assert "Traceback" not in err
+    assert out.read_text() == "precious\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.svg", "sorter.json"]
+
+
+def test_cli_missing_file_and_no_geometry(cli, sorter_json, tmp_path):
+    code, _, err = cli("draw", tmp_path / "nope.json")
+    assert code == 2 and "not found" in err and len(err.strip().splitlines()) == 1
+    obj = json.loads(sorter_json.read_text())
+    del obj["mechanism"]
+    for c in obj["cells"]:
+        c.pop("geometry", None)
+    bare = tmp_path / "bare.json"
+    bare.write_text(json.dumps(obj))
+    code, _, err = cli("draw", bare)
+    assert code == 2 and "no mechanism geometry" in err
+    assert not (tmp_path / "bare.svg").exists()
+
+
+def test_cli_writes_default_name_and_replaces(cli, sorter_json, tmp_path):
+    out = tmp_path / "sorter.svg"
+    out.write_text("old\n")
+    code, stdout, err = cli("draw", sorter_json, "--state", "C=1,D=1")
+    assert code == 0, err
+    assert "Z=1" in stdout
+    assert _outputs(out.read_text()) == {"Z": 1}
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_cli_compiles_a_spec(cli, tmp_path):
+    spec = tmp_path / "fa.bool"
+    spec.write_text((EXAMPLES / "full_adder.bool").read_text())
+    code, stdout, err = cli("draw", spec, "--state", "a=1,b=1")
+    assert code == 0, err
+    assert _outputs((tmp_path / "fa.svg").read_text()) == {"s": 0, "cout": 1}  # 1+1+0 = 10b
+
+
+def test_unsolved_body_is_shown_and_fails(cli, sorter, sorter_json, tmp_path, monkeypatch):
+    """If the solver reports a body it could not pose, the drawing says so (and does not
+    claim an output value from it) and the command exits 1."""
+    import mechc.mech.evaluate as ev
+
+    owner, pin = sorter.mechanism.outputs["Z"]
+    body = sorter.mechanism.owner_part(owner).terminals[pin].body
+    real = ev.evaluate
+
+    def broken(mech, lib, types, values):
+        poses = real(mech, lib, types, values)
+        poses.bad[body] = np.ones(1, dtype=bool)
+        return poses
+
+    monkeypatch.setattr(ev, "evaluate", broken)
+    out = tmp_path / "x.svg"
+    code, _, err = cli("draw", sorter_json, "-o", out)
+    assert code == 1 and body in err
+    svg = out.read_text()
+    root = ET.fromstring(svg)
+    assert any(g.get("data-body") == body and g.get("class") == "bad"
+               for g in root.iter(f"{NS}g"))
+    texts = [t.text or "" for t in root.iter(f"{NS}text")]
+    assert any("NOT SOLVED" in t for t in texts)
+    assert "Z = ? (not solved)" in texts and _outputs(svg) == {}
