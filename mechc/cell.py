@@ -3,6 +3,11 @@
 A cell is a small class in a file under ``stdlib/`` (or a directory given with ``--cells`` or
 ``MECHC_CELLS``); ``mechc cells`` lists it without any change to the compiler. See
 docs/write-a-cell.md.
+
+Besides its logic type and cost, a cell builds its mechanism (``synthesise``), and the compiler
+evaluates it with the generic closed-form kinematics and pymunk dynamics of
+``mechc.mech`` — a cell with parts those do not cover (cams, rollers, toggles) overrides
+``kinematics`` / ``build_dynamics``.
 """
 
 from __future__ import annotations
@@ -10,6 +15,11 @@ from __future__ import annotations
 import string
 from dataclasses import dataclass
 from typing import ClassVar
+
+import numpy as np
+
+from mechc.mech.build import Demand, SynthContext
+from mechc.mech.model import Part
 
 
 @dataclass(frozen=True)
@@ -55,3 +65,18 @@ class Cell:
     def cost(cls, n_inputs: int) -> int:
         """Parts count (bodies + springs) of an instance; the mapper minimises the sum."""
         raise NotImplementedError
+
+    @classmethod
+    def synthesise(cls, cid: str, ctx: SynthContext, n_inputs: int, params: dict,
+                   demand: Demand) -> Part:
+        """The mechanism at a local origin: input terminals on the left edge (x = 0), rows
+        going down from y = 0, every signal at half stroke. ``demand`` is the force the output
+        must deliver each way; the part's ``data["input_loads"]`` says what each input asks."""
+        raise NotImplementedError(f"cell {cls.name} has no mechanism")
+
+    @classmethod
+    def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):
+        """Poses of every body given the input terminal bodies' displacements (closed form)."""
+        from mechc.mech.kinematics import solve
+
+        return solve(part, fixed, size, extra)

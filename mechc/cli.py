@@ -24,8 +24,9 @@ DESCRIPTION = """\
 mechc compiles logic into mechanisms: a Boolean or sequential specification becomes a netlist of
 mechanical cells (sliders, levers, springs) with their geometry, and a simulation proves it.
 
-  mechc compile sorter.bool -o sorter.json     spec -> netlist JSON
-  mechc simulate sorter.json --level logic     prove a compiled design against its spec
+  mechc compile sorter.bool -o sorter.json     spec -> mechanism JSON (netlist + geometry)
+  mechc simulate sorter.json                   prove it (levels: logic, kinematic, dynamic)
+  mechc draw sorter.json -o sorter.svg         look at it
   mechc cells                                  list the cell library
 
 Exit status: 0 success, 1 a proof or design check failed, 2 bad input, 3 internal error.
@@ -81,13 +82,36 @@ def build_parser() -> argparse.ArgumentParser:
     c.set_defaults(func=cmd_compile)
 
     s = sub.add_parser("simulate", help="prove a design against its spec",
-                       description="Prove a design: SPEC_OR_JSON is a compiled design (.json) "
-                       "or a spec, compiled in memory first. At level 'logic' the netlist is "
-                       "evaluated on every input vector and compared with the spec (don't-cares "
-                       "excepted). Exit 0 only if the proof holds.")
+                       formatter_class=argparse.RawDescriptionHelpFormatter,
+                       description="""\
+Prove a design: SPEC_OR_JSON is a compiled design (.json) or a spec, compiled in memory first.
+
+levels:
+  logic      the netlist's cells evaluated as Boolean functions on every input vector
+  kinematic  the mechanism's closed forms (from its geometry, not its logic types) on every
+             input vector at rest and sampled along every single-input change: outputs within
+             --tolerance of their positions, outputs that must not change dwell; design checks
+  dynamic    (default) pymunk rigid bodies, springs and contacts; inputs moved by bounded-force
+             actuators along a Gray-code tour of every vector plus --cases seeded random
+             changes; outputs at rest, glitches, settling, joint violations (solver error)
+
+Exit status 0 only if the proof holds; 1 if it fails (the failures are listed).""")
     s.add_argument("design", metavar="SPEC_OR_JSON")
-    s.add_argument("--level", choices=["logic"], default="logic",
+    s.add_argument("--level", choices=["logic", "kinematic", "dynamic"], default="dynamic",
                    help="simulation level (default: %(default)s)")
+    s.add_argument("--tolerance", type=float, default=0.05, metavar="F",
+                   help="outputs must sit within F of stroke of their position (default: "
+                   "%(default)s)")
+    s.add_argument("--cases", type=int, default=16, metavar="N",
+                   help="dynamic: seeded random single-input changes after the Gray tour "
+                   "(default: %(default)s)")
+    s.add_argument("--seed", type=int, default=0, help="seed for the random cases")
+    s.add_argument("--dt", type=float, default=None, metavar="S",
+                   help="dynamic: time step in seconds (default 2.5e-4)")
+    s.add_argument("--iterations", type=int, default=None,
+                   help="dynamic: solver iterations per step (default 60)")
+    s.add_argument("--move-time", type=float, default=None, metavar="S",
+                   help="dynamic: seconds an input takes to move (default 0.08)")
     s.add_argument("--spec", metavar="OTHER",
                    help="prove against this spec instead of the one the design was compiled from")
     s.add_argument("--report", metavar="FILE.json", help="write the proof report as JSON")
@@ -102,6 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
     k.add_argument("--json", action="store_true", help="print as JSON")
     k.set_defaults(func=cmd_cells)
 
+    _register_optional(sub, "mechc.draw")  # mechc draw ...
     _register_optional(sub, "mechc.synthesis.cli")  # mechc synth ...
     return p
 
@@ -133,6 +158,16 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
                    "cheapest; sop: sums of products only (default: %(default)s)")
     g.add_argument("--no-share", action="store_true",
                    help="do not share product terms between outputs")
+    g.add_argument("--keep-hazards", action="store_true",
+                   help="build the minimum covers as they are, without consensus terms (outputs "
+                   "may then dip during single-input changes)")
+    m = c.add_argument_group("mechanism")
+    m.add_argument("--stroke", type=float, default=20.0, metavar="MM",
+                   help="stroke of every terminal, off to on (default: %(default)s mm)")
+    m.add_argument("--actuator-force", type=float, default=100.0, metavar="N",
+                   help="rated force of each input actuator (default: %(default)s N)")
+    m.add_argument("--output-load", type=float, default=0.5, metavar="N",
+                   help="force each circuit output must move either way (default: %(default)s N)")
 
 
 def _positive_int(lo: int):
@@ -150,15 +185,24 @@ def _positive_int(lo: int):
 
 def _options(args):
     from mechc.logic.minimise import MinimiseOptions
+    from mechc.mech.assemble import MechOptions
     from mechc.netlist.mapping import MapOptions
     from mechc.pipeline import CompileOptions
 
     if args.time_limit <= 0:
         raise UsageError("--time-limit must be positive")
+    if not 1.0 <= args.stroke <= 500.0:
+        raise UsageError("--stroke must be between 1 and 500 mm")
+    if args.actuator_force <= 0 or args.output_load < 0:
+        raise UsageError("--actuator-force must be positive and --output-load not negative")
     return CompileOptions(
         minimise=MinimiseOptions(time_limit=args.time_limit, share=not args.no_share,
-                                 complements=args.phase == "auto"),
-        map=MapOptions(fan_in=args.fan_in, phase=args.phase),
+                                 complements=args.phase == "auto",
+                                 hazard_free=not args.keep_hazards),
+        map=MapOptions(fan_in=args.fan_in, phase=args.phase,
+                       hazard_free=not args.keep_hazards),
+        mech=MechOptions(stroke=args.stroke, actuator_force=args.actuator_force,
+                         output_load=args.output_load),
         cell_dirs=tuple(args.cell_dirs),
         timings=getattr(args, "timings", False),
     )
@@ -184,9 +228,15 @@ def cmd_compile(args) -> int:
     validate(obj, out)
     write_atomic(out, dumps(obj))
     st = design.stats
+    methods = {v["method"] for v in st["minimisation"]["outputs"].values()}
+    if st["minimisation"]["proven"]:
+        how = "minimum proven"
+    elif "espresso" in methods:
+        how = "heuristic cover (espresso-style, wide PLA): not proven minimal"
+    else:
+        how = "minimum NOT proven (time limit or too many primes)"
     print(f"{args.spec} -> {out}: {st['cells']} cells ({_by_type(st['cells_by_type'])}), "
-          f"{st['parts']} parts, {st['literals']} literals, minimum "
-          f"{'proven' if st['minimisation']['proven'] else 'NOT proven (time limit)'}, "
+          f"{st['parts']} parts, {st['literals']} literals, {how}, "
           f"{time.perf_counter() - t0:.2f} s")
     for o in design.spec.outputs:
         print(f"  {o} = {design.equations[o]}")
@@ -194,6 +244,16 @@ def cmd_compile(args) -> int:
             print(f"  {' ' * len(o)}   built as {design.implemented[o]}")
     if args.print_netlist:
         print(design.netlist.to_text(), end="")
+    dc = st.get("design_checks", {})
+    if dc and not dc["passed"]:
+        print(f"DESIGN CHECKS FAILED ({len(dc['failed'])} of {dc['count']}); the design was "
+              f"written to {out} for inspection:", file=sys.stderr)
+        for text in dc["failed"][:20]:
+            print(f"  {text}", file=sys.stderr)
+        return EXIT_FAILED
+    if dc:
+        print(f"  design checks: {dc['count']} passed (min transmission angle "
+              f"{dc['min_transmission_angle_deg']}°)")
     return EXIT_OK
 
 
@@ -210,29 +270,104 @@ def load_design_or_spec(path: str, args):
 
 
 def cmd_simulate(args) -> int:
-    from mechc.sim.logic import prove_logic
+    from mechc.library import load_library
     from mechc.spec import load_spec
     from mechc.writer import dumps, write_atomic
 
+    if not 0 < args.tolerance < 0.5:
+        raise UsageError("--tolerance must be between 0 and 0.5")
+    if args.cases < 0:
+        raise UsageError("--cases must not be negative")
     design = load_design_or_spec(args.design, args)
     spec = load_spec(args.spec) if args.spec else design.spec
-    report = prove_logic(design.netlist, spec)
+    lib = load_library(args.cell_dirs)
+    if args.level == "logic":
+        from mechc.sim.logic import prove_logic
+
+        report = prove_logic(design.netlist, spec)
+    elif args.level == "kinematic":
+        from mechc.sim.kinematic import prove_kinematic
+
+        report = prove_kinematic(design, spec, lib, tolerance=args.tolerance, seed=args.seed)
+    else:
+        from mechc.mech.dynamics import DynSettings
+        from mechc.sim.dynamic import prove_dynamic
+        from mechc.ui import Progress
+
+        st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
+                         if design.mechanism else 0.1)
+        for opt, field_name in (("dt", "dt"), ("iterations", "iterations"),
+                                ("move_time", "move_time")):
+            v = getattr(args, opt)
+            if v is not None:
+                if v <= 0:
+                    raise UsageError(f"--{opt.replace('_', '-')} must be positive")
+                setattr(st, field_name, v)
+        bar = Progress(1, f"dynamic proof of {Path(args.design).name}")
+
+        def tick(done, total):
+            bar.total = total
+            bar.update(done, "input changes")
+
+        try:
+            report = prove_dynamic(design, spec, lib, st, tolerance=args.tolerance,
+                                   extra=args.cases, seed=args.seed, progress=tick)
+        finally:
+            bar.close()
     report["design"] = args.design
     report["spec"] = args.spec or design.spec.path
-    rows = [[o, "pass" if not any(f["output"] == o for f in report["failures"]) else "FAIL"]
-            for o in spec.outputs]
-    print(table(rows, ["output", "logic"]))
-    verdict = "PASSED" if report["passed"] else "FAILED"
-    print(f"{verdict}: level {report['level']}, {report['cases']} input vectors, "
-          f"{report['failure_count']} wrong output values, {report['seconds']:.3f} s")
-    for f in report["failures"][:10]:
-        ins = " ".join(f"{k}={v}" for k, v in f["inputs"].items())
-        print(f"  {f['output']}: expected {f['expected']}, got {f['got']} at {ins}")
-    if report["failure_count"] > 10:
-        print(f"  ... and {report['failure_count'] - 10} more")
+    print_report(report, spec)
     if args.report:
         write_atomic(args.report, dumps(report))
     return EXIT_OK if report["passed"] else EXIT_FAILED
+
+
+SUMMARY_KEYS = [
+    ("cases", "input states / changes"), ("transitions", "single-input changes"),
+    ("max_position_error_fraction", "max output error vs closed form (fraction of stroke)"),
+    ("max_deviation_fraction", "max output deviation from spec (fraction of stroke)"),
+    ("min_margin_fraction", "min margin to mid-stroke (fraction of stroke)"),
+    ("max_joint_violation_mm", "max joint violation (mm)"),
+    ("max_contact_penetration_mm", "max contact overrun (mm)"),
+    ("max_settle_time_s", "max settle time (s)"),
+    ("min_transmission_angle_deg", "min transmission angle (deg)"),
+    ("min_toggle_distance_deg", "min distance from toggle (deg)"),
+    ("seconds", "seconds"),
+]
+
+
+def print_report(report: dict, spec) -> None:
+    rows = [[label, report[k]] for k, label in SUMMARY_KEYS if report.get(k) is not None]
+    print(table(rows, ["level " + report["level"], "value"]))
+    verdict = "PASSED" if report["passed"] else "FAILED"
+    kinds = report.get("failure_kinds")
+    extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
+    print(f"{verdict}: level {report['level']}, {report['cases']} cases, "
+          f"{report['failure_count']} failures{extra}, {report['seconds']:.3f} s")
+    for f in report["failures"][:10]:
+        print("  " + _failure_text(f))
+    if report["failure_count"] > 10:
+        print(f"  ... and {report['failure_count'] - 10} more (see --report)")
+
+
+def _failure_text(f: dict) -> str:
+    if "message" in f and "inputs" not in f:
+        return f["message"]
+    ins = " ".join(f"{k}={v}" for k, v in f.get("inputs", {}).items())
+    kind = f.get("kind", "")
+    if kind in ("", "rest") and "got" in f:
+        return f"{f['output']}: expected {f['expected']}, got {f['got']} at {ins}"
+    head = f"{kind}: "
+    if "moving" in f:
+        head += f"{f['moving']} -> {f.get('to', '')} " if "to" in f else f"{f['moving']} moving "
+    if "output" in f:
+        head += f"output {f['output']} (expected {f['expected']}) "
+        for key in ("position", "max_deviation", "max_deviation_fraction", "deviation_fraction"):
+            if key in f:
+                head += f"{key.replace('_', ' ')} {f[key]} "
+    if "message" in f:
+        head += f["message"] + " "
+    return head + f"at {ins}"
 
 
 def cmd_cells(args) -> int:

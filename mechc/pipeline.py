@@ -1,6 +1,7 @@
 """The compiler as a pipeline of plain stages with explicit data between them.
 
-    Spec --minimise--> Equations --map--> Netlist --place--> Layout  => Design
+    Spec --minimise--> Equations --map--> Netlist --place--> Layout
+         --synthesise--> Mechanism  => Design
 
 ``compile_spec`` runs them in order and times each; every stage can also be called alone.
 """
@@ -14,6 +15,7 @@ from dataclasses import dataclass, field
 from mechc.layout import Layout, place
 from mechc.library import Library, load_library
 from mechc.logic.minimise import Equations, MinimiseOptions, minimise
+from mechc.mech.assemble import Mechanism, MechOptions, synthesise_mechanism
 from mechc.netlist.ir import Netlist
 from mechc.netlist.mapping import MapOptions, map_equations
 from mechc.spec.model import Spec
@@ -23,6 +25,7 @@ from mechc.spec.model import Spec
 class CompileOptions:
     minimise: MinimiseOptions = field(default_factory=MinimiseOptions)
     map: MapOptions = field(default_factory=MapOptions)
+    mech: MechOptions = field(default_factory=MechOptions)
     cell_dirs: tuple[str, ...] = ()
     timings: bool = False  # record seconds per stage in the JSON (makes output non-reproducible)
 
@@ -39,6 +42,7 @@ class Design:
     stats: dict
     seconds: dict[str, float] = field(default_factory=dict)
     eq: Equations | None = None  # the minimiser's full result (not kept in JSON)
+    mechanism: Mechanism | None = None
 
 
 def compile_spec(spec: Spec, opts: CompileOptions | None = None,
@@ -59,9 +63,50 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
     eq = stage("minimise", minimise, spec, opts.minimise)
     mapped = stage("map", map_equations, eq, lib, opts.map)
     layout = stage("place", place, mapped.netlist)
+    mech = stage("synthesise", synthesise_mechanism, mapped.netlist, layout, lib, opts.mech)
     stats = design_stats(eq, mapped.netlist, lib, layout)
-    return Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
-                  mapped.netlist, layout, stats, seconds, eq)
+    design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
+                    mapped.netlist, layout, stats, seconds, eq, mech)
+    stage("check", run_design_checks, design, lib)
+    return design
+
+
+def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = None,
+                    library: Library | None = None) -> Design:
+    """The back half of the pipeline for a netlist given by hand (a single cell under test, a
+    circuit drawn from a figure): place, synthesise, check."""
+    opts = opts or CompileOptions()
+    lib = library or load_library(opts.cell_dirs)
+    netlist.check()
+    layout = place(netlist)
+    mech = synthesise_mechanism(netlist, layout, lib, opts.mech)
+    stats = {"cells": len(netlist.cells), "cells_by_type": netlist.count_by_type()}
+    design = Design(spec, {}, {}, netlist, layout, stats, {}, None, mech)
+    run_design_checks(design, lib)
+    return design
+
+
+def run_design_checks(design: Design, lib: Library) -> None:
+    """Measure the design checks on the closed-form kinematics (every input state and every
+    single-input change up to 10 inputs) and record them in the mechanism and the stats."""
+    from mechc.mech.checks import CheckStats
+    from mechc.sim.kinematic import sweep
+
+    mech = design.mechanism
+    stats = CheckStats(mech)
+    wide = len(design.netlist.inputs) > 10
+    # a budget of cell-states, so a big design is checked on a sample (the kinematic proof,
+    # `mechc simulate --level kinematic`, remains exhaustive up to 10 inputs)
+    budget = max(4000, 4_000_000 // max(1, len(design.netlist.cells)))
+    sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
+    measured = stats.checks()
+    mech.checks = [c for c in mech.checks if c.name == "actuator force"] + measured
+    failed = [c for c in mech.checks if not c.passed]
+    mus = [c.value for c in mech.checks if c.name == "transmission angle"]
+    design.stats["design_checks"] = {
+        "passed": not failed, "count": len(mech.checks), "failed": [c.text() for c in failed],
+        "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
+    }
 
 
 def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None) -> dict:
@@ -79,6 +124,9 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
         "shared_terms": eq.shared_terms,
         "depth": max(nl.depth().values(), default=0),
         "crossings": layout.crossings if layout else None,
-        "minimisation": {"proven": eq.proven, "verified": "exhaustive",
+        "minimisation": {"proven": eq.proven,
+                         "verified": "exhaustive" if all(c.method != "espresso" for c in
+                                                         eq.covers.values())
+                         else "exact on cubes",
                          "outputs": per_output},
     }

@@ -21,10 +21,13 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
     nl = d.netlist
     places = d.layout.cells if d.layout else {}
     cells = []
+    mech = d.mechanism
     for c in nl.topo_cells():
         j = c.to_json()
         if c.id in places:
             j["place"] = places[c.id].to_json()
+        if mech is not None and c.id in mech.cells:
+            j["geometry"] = mech.cells[c.id].to_json()
         cells.append(j)
     nets = [{"id": k, **v} for k, v in sorted(nl.nets().items(), key=lambda kv: _net_key(kv[0]))]
     stats = dict(d.stats)
@@ -44,6 +47,10 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
         "layout": d.layout.to_json() if d.layout else None,
         "stats": stats,
     }
+    if mech is not None:
+        from mechc.mech.io import mechanism_json
+
+        out["mechanism"] = mechanism_json(mech)
     return out
 
 
@@ -63,6 +70,10 @@ def write_atomic(path: str | Path, text: str) -> None:
     p = Path(path)
     if p.is_dir():
         raise UsageError(f"{p}: is a directory, expected an output file name")
+    if p.exists() and not p.is_file():  # a device or pipe (/dev/stdout, /dev/null): no rename
+        with open(p, "w", encoding="utf-8") as f:
+            f.write(text)
+        return
     parent = p.parent if str(p.parent) else Path(".")
     if not parent.is_dir():
         raise UsageError(f"{p}: directory '{parent}' does not exist")
@@ -134,5 +145,13 @@ def design_from_json(obj: dict, where: str = "<json>") -> Design:
         lj = obj["layout"]
         layout = Layout(cells, {k: Place(**v) for k, v in lj.get("inputs", {}).items()},
                         tuple(lj.get("pitch_mm", (0, 0))), lj.get("crossings", 0))
+    mech = None
+    if obj.get("mechanism"):
+        from mechc.mech.io import mechanism_from_json
+
+        try:
+            mech = mechanism_from_json(obj["mechanism"], obj["cells"])
+        except (KeyError, TypeError, ValueError) as e:
+            raise UsageError(f"{where}: inconsistent mechanism geometry: {e}") from None
     return Design(spec, obj.get("equations", {}), obj.get("implemented", {}), nl, layout,
-                  obj.get("stats", {}))
+                  obj.get("stats", {}), mechanism=mech)

@@ -1,1 +1,1 @@
-"""mechc's cell library: one file per cell (or cell family). See docs/write-a-cell.md."""
+"""mechc's cell library: one file per cell. See docs/write-a-cell.md."""

@@ -1,6 +1,7 @@
-"""Ternary lever pivoted at its centre: input right, output left (001 Fig 16c)."""
+"""NOT: a ternary lever pivoted at its centre; the input moves right, the output left (Fig 16c)."""
 
 from mechc.cell import Cell
+from mechc.mech.build import Builder, Demand
 
 
 class NotLever(Cell):
@@ -8,8 +9,22 @@ class NotLever(Cell):
     type = "NOT"
     min_inputs = 1
     max_inputs = 1
-    description = "ternary lever pivoted at its centre: input right, output left (001 Fig 16c)"
+    description = "lever pivoted at its centre: input right, output left (Fig 16c)"
 
     @classmethod
     def cost(cls, n_inputs: int) -> int:
-        return 1
+        return 3  # input slider, lever, output slider
+
+    @classmethod
+    def synthesise(cls, cid, ctx, n_inputs, params, demand):
+        b = Builder(cid, ctx)
+        S, w = ctx.stroke, ctx.bar
+        a = b.input_slider("A", 0.0, 0.0, 1.0 * S)
+        out, load = b.not_lever("lever", a, 1.0 * S + w, 0.0, demand, 1.2 * S)
+        b.output(out, "Z")
+        return b.finish({"A": load})
+
+
+def inverse(demand: Demand, ctx) -> Demand:
+    """What a NOT lever asks of its input when its output must deliver ``demand``."""
+    return Demand(demand.left + ctx.friction, demand.right + ctx.friction)

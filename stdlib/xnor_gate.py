@@ -1,6 +1,8 @@
-"""Coincidence linkage (001 Fig 10)."""
+"""XNOR (coincidence): the XOR cell's OR bar driving an inverting lever (001 §2.3.7)."""
 
 from mechc.cell import Cell
+from mechc.mech.build import Builder, Demand, Sig
+from stdlib.xor_gate import build_xor
 
 
 class XnorGate(Cell):
@@ -8,8 +10,19 @@ class XnorGate(Cell):
     type = "XNOR"
     min_inputs = 2
     max_inputs = 2
-    description = "coincidence linkage (001 Fig 10)"
+    description = "coincidence: the or-exclusive linkage with an inverting output lever (Fig 10)"
 
     @classmethod
     def cost(cls, n_inputs: int) -> int:
-        return 6
+        return 15
+
+    @classmethod
+    def synthesise(cls, cid, ctx, n_inputs, params, demand):
+        b = Builder(cid, ctx)
+        f = ctx.friction
+        bar, loads = build_xor(b, Demand(demand.left + f, demand.right + f))
+        y_low = -ctx.arm - ctx.pitch
+        out, _ = b.not_lever("lever", Sig(bar.body, bar.x, y_low), bar.x + ctx.bar, y_low,
+                             demand, 1.0 * ctx.stroke)
+        b.output(out, "Z")
+        return b.finish(loads)

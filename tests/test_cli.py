@@ -177,10 +177,9 @@ def test_cells_lists_the_library(cli):
 
 def test_user_cell_directory_is_picked_up_without_compiler_edits(cli, tmp_path):
     (tmp_path / "my_and.py").write_text(
-        "from mechc.cell import Cell\n\n\nclass CheapAnd(Cell):\n    name = 'cheap_and'\n"
-        "    type = 'AND'\n    min_inputs = 2\n    max_inputs = 2\n"
-        "    description = 'test cell'\n\n    @classmethod\n    def cost(cls, n):\n"
-        "        return 1\n")
+        "from stdlib.and_gate import AndGate\n\n\nclass CheapAnd(AndGate):\n"
+        "    name = 'cheap_and'\n    max_inputs = 2\n    description = 'test cell'\n\n"
+        "    @classmethod\n    def cost(cls, n):\n        return 1\n")
     code, out, _ = cli("cells", "--cells", tmp_path)
     assert code == 0 and "cheap_and" in out
     design = tmp_path / "d.json"
@@ -190,7 +189,36 @@ def test_user_cell_directory_is_picked_up_without_compiler_edits(cli, tmp_path):
     assert json.loads(design.read_text())["cells"][0]["cell"] == "cheap_and"
 
 
+def test_user_cell_without_mechanism_is_a_clear_error(cli, tmp_path):
+    (tmp_path / "bare.py").write_text(
+        "from mechc.cell import Cell\n\n\nclass Bare(Cell):\n    name = 'bare_and'\n"
+        "    type = 'AND'\n    description = 'no geometry'\n\n    @classmethod\n"
+        "    def cost(cls, n):\n        return 0\n")
+    spec = tmp_path / "s.bool"
+    spec.write_text("inputs a b\noutputs z\nz = a & b\n")
+    code, _, err = cli("compile", spec, "-o", tmp_path / "d.json", "--cells", tmp_path)
+    assert code == 1 and "has no mechanism" in err and "Traceback" not in err
+
+
 def test_broken_user_cell_reports_file_and_line(cli, tmp_path):
     (tmp_path / "broken.py").write_text("x = 1\nraise RuntimeError('boom')\n")
     code, _, err = cli("cells", "--cells", tmp_path)
     assert code == 2 and "broken.py:2:" in err and "boom" in err and "Traceback" not in err
+
+
+def test_output_to_a_device_is_written_not_replaced(cli, tmp_path):
+    import os
+    import stat
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    import threading
+
+    got = []
+    t = threading.Thread(target=lambda: got.append(open(fifo).read()))
+    t.start()
+    code, _, err = cli("compile", EXAMPLES / "sorter.bool", "-o", fifo)
+    t.join(10)
+    assert code == 0, err
+    assert stat.S_ISFIFO(os.stat(fifo).st_mode)  # still a pipe, not replaced by a file
+    assert '"format": "mechc"' in got[0]

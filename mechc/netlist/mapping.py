@@ -27,6 +27,7 @@ Key = tuple  # ("in", name) | ("CONST", value) | (TYPE, (child keys...))
 class MapOptions:
     fan_in: int | None = None  # cap on AND/OR/NAND/NOR inputs (default: the library's limit)
     phase: str = "auto"  # "auto": also try complement and XOR forms; "sop": sum of products only
+    hazard_free: bool = True  # build covers with consensus terms (outputs dwell; §3)
 
 
 class Planner:
@@ -140,10 +141,14 @@ def map_equations(eq: Equations, library: Library, opts: MapOptions | None = Non
     built: set = set()
     roots: dict[str, Key] = {}
     for name in eq.outputs:
-        cands = [pl.sop(eq.covers[name], eq.inputs)]
+        cover = eq.hazard_free.get(name, eq.covers[name]) if opts.hazard_free else eq.covers[name]
+        cands = [pl.sop(cover, eq.inputs)]
         if opts.phase == "auto":
-            if name in eq.complements:
-                cands.append(pl.sop(eq.complements[name], eq.inputs, invert=True))
+            comp = eq.complements.get(name)
+            if opts.hazard_free:
+                comp = eq.hazard_free_complements.get(name, comp)
+            if comp is not None:
+                cands.append(pl.sop(comp, eq.inputs, invert=True))
             xf = eq.xor_forms.get(name)
             if xf is not None:
                 cands.extend(_xor_candidates(pl, xf, eq.inputs))
@@ -211,6 +216,7 @@ def _materialise(roots: dict[str, Key], eq: Equations, library: Library) -> Netl
     counter = {"cell": 0, "net": 0}
     # outputs driven by a cell give their name to that net (first output wins)
     out_net_name: dict[Key, str] = {}
+    taken = set(eq.inputs) | set(roots)
     for name, key in roots.items():
         if key[0] != "in" and key not in out_net_name:
             out_net_name[key] = name
@@ -229,8 +235,11 @@ def _materialise(roots: dict[str, Key], eq: Equations, library: Library) -> Netl
         if key in out_net_name:
             net = out_net_name[key]
         else:
-            counter["net"] += 1
-            net = f"n{counter['net']}"
+            while True:  # an output or input may already be called n7
+                counter["net"] += 1
+                net = f"n{counter['net']}"
+                if net not in taken:
+                    break
         cid = f"c{counter['cell']}"
         nl.add_cell(CellInst(cid, cell_cls.name, type_name, tuple(ins), (net,), params),
                     pin_names=cell_cls.input_names(len(ins)), out_pins=list(cell_cls.outputs))

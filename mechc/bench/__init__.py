@@ -1,0 +1,1 @@
+"""Benchmark support: generated circuits and timing helpers (used by benchmarks/)."""

@@ -1,0 +1,104 @@
+"""Random circuits of a chosen size, with the spec they compute, for benchmarks.
+
+A circuit is grown as a random DAG of library cells (fan-in 2, fan-out at most 3, depth kept
+moderate so the force budget stays within an actuator's reach); every net nobody reads becomes
+an output; the spec is the circuit's own truth table, so a proof of it is a proof that the
+mechanism computes what its netlist says.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from mechc.logic.cubes import Cube, input_matrix
+from mechc.netlist.ir import CellInst, Netlist
+from mechc.spec.model import OutputSpec, Spec
+
+TYPES = ["AND", "OR", "NAND", "NOR", "AND_NOT", "OR_NOT", "NOT"]
+CELL_OF = {"AND": "and", "OR": "or", "NAND": "nand", "NOR": "nor", "AND_NOT": "and_not",
+           "OR_NOT": "or_not", "NOT": "not", "XOR": "xor"}
+
+
+def random_netlist(n_cells: int, n_inputs: int = 6, seed: int = 0, max_depth: int = 5,
+                   max_fanout: int = 3) -> Netlist:
+    rng = np.random.default_rng(seed)
+    inputs = [f"x{i}" for i in range(n_inputs)]
+    nl = Netlist(inputs)
+    depth = {x: 0 for x in inputs}
+    fanout = {x: 0 for x in inputs}
+    nets = list(inputs)
+    for c in range(1, n_cells + 1):
+        t = TYPES[int(rng.integers(len(TYPES)))]
+        k = 1 if t == "NOT" else 2
+        pool = [x for x in nets if fanout[x] < max_fanout and depth[x] < max_depth]
+        # prefer nets nobody reads yet, so every cell ends up in some output's cone
+        unread = [x for x in pool if fanout[x] == 0]
+        ins: list[str] = []
+        while len(ins) < k:
+            src = unread if unread and rng.random() < 0.7 else pool
+            cand = [x for x in src if x not in ins]
+            if not cand:
+                cand = [x for x in pool if x not in ins]
+            pick = cand[int(rng.integers(len(cand)))]
+            ins.append(pick)
+            if pick in unread:
+                unread.remove(pick)
+        out = f"n{c}"
+        nl.add_cell(CellInst(f"c{c}", CELL_OF[t], t, tuple(ins), (out,)))
+        for x in ins:
+            fanout[x] += 1
+        depth[out] = 1 + max(depth[x] for x in ins)
+        fanout[out] = 0
+        nets.append(out)
+    outs = [x for x in nets if fanout[x] == 0 and x not in inputs]
+    for i, net in enumerate(outs):
+        nl.set_output(f"z{i}", net)
+    nl.check()
+    return nl
+
+
+def spec_of(nl: Netlist, name: str = "random") -> Spec:
+    n = len(nl.inputs)
+    m = input_matrix(n)
+    nets = nl.evaluate({x: m[k] for k, x in enumerate(nl.inputs)})
+    funcs = {}
+    for o, net in nl.outputs.items():
+        on = np.flatnonzero(nets[net])
+        funcs[o] = OutputSpec(o, on=[Cube.minterm(int(x), n) for x in on])
+    return Spec(name, "bool", list(nl.inputs), list(nl.outputs), funcs)
+
+
+def random_compiled(target_cells: int, seed: int = 0, options=None):
+    """A design compiled by mechc from a random spec, grown until it has about
+    ``target_cells`` cells (±25 %): hazard-free, as every compiled design is."""
+    from mechc.pipeline import compile_spec
+
+    rng = np.random.default_rng(seed)
+    n_in, n_out = 4, 1
+    best = None
+    for _ in range(40):
+        n = 1 << n_in
+        funcs = {}
+        for j in range(n_out):
+            t = rng.random(n)
+            on = np.flatnonzero(t < 0.4)
+            dc = np.flatnonzero((t >= 0.4) & (t < 0.5))
+            funcs[f"z{j}"] = OutputSpec(f"z{j}", on=[Cube.minterm(int(x), n_in) for x in on],
+                                        dc=[Cube.minterm(int(x), n_in) for x in dc])
+        spec = Spec(f"random{target_cells}", "bool", [f"x{i}" for i in range(n_in)],
+                    list(funcs), funcs)
+        d = compile_spec(spec, options)
+        cells = len(d.netlist.cells)
+        if best is None or abs(cells - target_cells) < abs(len(best.netlist.cells)
+                                                             - target_cells):
+            best = d
+        if abs(cells - target_cells) <= 0.25 * target_cells:
+            return d
+        if cells < target_cells:
+            if n_out < 4:
+                n_out += 1
+            else:
+                n_in, n_out = n_in + 1, 1
+        else:
+            n_out = max(1, n_out - 1)
+    return best

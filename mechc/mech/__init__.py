@@ -1,0 +1,1 @@
+"""Mechanisms: geometry of cells and connectors, their kinematic and dynamic models, checks."""
