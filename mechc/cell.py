@@ -39,7 +39,8 @@ class Cell:
     - ``min_inputs`` / ``max_inputs``: how many input pins it can have (fan-in);
     - ``pin_kind``: ``"translating"`` or ``"rotating"`` terminals;
     - ``outputs``: output pin names;
-    - ``description``: one line for ``mechc cells``.
+    - ``description``: one line for ``mechc cells``;
+    - ``auto_select``: False keeps the mapper from choosing it unless asked for by name.
     """
 
     name: ClassVar[str] = ""
@@ -50,6 +51,8 @@ class Cell:
     pin_kind: ClassVar[str] = "translating"
     description: ClassVar[str] = ""
     source: ClassVar[str] = ""  # set by the library loader: file the cell came from
+    auto_select: ClassVar[bool] = True  # offered to the mapper by cost (else only on request)
+    stateful: ClassVar[bool] = False  # kinematics needs the previous state (MEMORY)
 
     @classmethod
     def input_names(cls, n: int) -> list[str]:
@@ -80,3 +83,8 @@ class Cell:
         from mechc.mech.kinematics import solve
 
         return solve(part, fixed, size, extra)
+
+    @classmethod
+    def build_dynamics(cls, scene, part: Part) -> None:
+        """Add to the pymunk scene what the generic bodies, joints and springs of ``part``
+        leave out (motors, special shapes); the default adds nothing."""

@@ -293,7 +293,7 @@ def _labels(design, mover: _Mover, outs: dict[str, float], state: dict[str, int]
         sig = outs.get(name, float("nan"))
         # right of the output body's tip on the terminal's row (connectors excepted)
         b = mover.bodies[t.body]
-        mid = ((t.off[0] + t.on[0]) / 2, (t.off[1] + t.on[1]) / 2)
+        mid = t.design_point
         tip = max([mid] + [p for i, poly in enumerate(b.outline) if i not in conn.get(b.id, ())
                            for p in poly if abs(p[1] - mid[1]) < mech.ctx.bar])
         x, _ = mover.pt(b.id, tip)

@@ -34,11 +34,21 @@ class Library:
     def __contains__(self, name: str) -> bool:
         return name in self.cells
 
-    def for_type(self, type_name: str, n_inputs: int) -> type[Cell] | None:
-        """Cheapest cell realising ``type_name`` with ``n_inputs`` inputs (ties: by name)."""
+    def for_type(self, type_name: str, n_inputs: int,
+                 prefer: Iterable[str] = ()) -> type[Cell] | None:
+        """Cheapest cell realising ``type_name`` with ``n_inputs`` inputs (ties: by name) among
+        the cells offered to the mapper (``auto_select``) and those named in ``prefer``; a
+        preferred cell that fits wins."""
         best = None
+        prefer = set(prefer)
+        for name in sorted(prefer):
+            cell = self.cells.get(name)
+            if cell and cell.type == type_name and cell.min_inputs <= n_inputs <= cell.max_inputs:
+                return cell
         for cell in self.cells.values():
             if cell.type != type_name or not cell.min_inputs <= n_inputs <= cell.max_inputs:
+                continue
+            if not cell.auto_select:
                 continue
             key = (cell.cost(n_inputs), cell.name)
             if best is None or key < best[0]:

@@ -68,25 +68,21 @@ def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,
     out_nets = set(nl.outputs.values())
 
     # ---- force budget and cell synthesis, outputs first -------------------------------------
-    demand: dict[str, Demand] = {}
-    for net in out_nets:
-        demand[net] = Demand(opts.output_load, opts.output_load)
-    local: dict[str, Part] = {}
-    for cid in reversed(order):
-        c = cells[cid]
-        cls = lib[c.cell]
-        d = demand.get(c.outputs[0], Demand())
-        try:
-            part = cls.synthesise(cid, ctx, len(c.inputs), c.params, d)
-        except NotImplementedError:
-            raise DesignError(f"cell '{c.cell}' ({cls.source}) has no mechanism: implement "
-                              "synthesise() (see docs/write-a-cell.md)") from None
-        part.data["output_demand"] = d.to_json()
-        local[cid] = part
-        for net, pin in zip(c.inputs, cls.input_names(len(c.inputs))):
-            ld = part.data["input_loads"][pin]
-            add = Demand(ld["right_N"] + ctx.friction, ld["left_N"] + ctx.friction)
-            demand[net] = demand.get(net, Demand()) + add
+    # a feedback net (a MEMORY's state) is loaded by cells synthesised after its driver: size
+    # again with the loads found in the pass before until the demands stop growing
+    feedback = any(getattr(lib[c.cell], "stateful", False) for c in cells.values())
+    before: dict[str, Demand] = {}
+    for _ in range(4 if feedback else 1):
+        demand, local = _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before)
+        grown = any(demand[n].right > before.get(n, Demand()).right + 1e-9
+                    or demand[n].left > before.get(n, Demand()).left + 1e-9 for n in demand)
+        before = demand
+        if not grown:
+            break
+    else:
+        if feedback:
+            raise DesignError("the force budget around the MEMORY feedback loops does not "
+                              "converge (each pass asks more force)")
 
     # ---- placement: columns by depth, real sizes -------------------------------------------
     depth = nl.depth()
@@ -155,10 +151,12 @@ def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,
             for j, (cid, pin) in enumerate(loads[net]):
                 lt = placed[cid].terminals[pin]
                 lx, ly = _mid(lt)
-                if lx - x_bar < 0.5 * S:
+                # a load left of its driver is a feedback path (a MEMORY's state): the rod runs
+                # back over the cells between, on the net's own plane
+                if abs(lx - x_bar) < 0.5 * S:
                     raise DesignError(f"net {net}: load {cid}.{pin} too close to its fan-out bar")
                 rods.joints.append(Joint(f"net.{net}.rod{j + 1}", "rod", term.body, lt.body,
-                                         pa=(x_bar, ly), pb=(lx, ly), length=lx - x_bar))
+                                         pa=(x_bar, ly), pb=(lx, ly), length=abs(lx - x_bar)))
                 ys.append(ly)
             body = dpart.body(term.body)
             layers = body.poly_layers or [body.layer] * len(body.outline)
@@ -194,5 +192,33 @@ def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,
     return Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
 
 
+def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):
+    """One pass of the force budget: cells from the outputs back, each sized for what its
+    output must deliver (``before``: a previous pass's demands, a floor for feedback nets)."""
+    demand: dict[str, Demand] = {}
+    for net in out_nets:
+        demand[net] = Demand(opts.output_load, opts.output_load)
+    local: dict[str, Part] = {}
+    for cid in reversed(order):
+        c = cells[cid]
+        cls = lib[c.cell]
+        d = demand.get(c.outputs[0], Demand())
+        prev = before.get(c.outputs[0])
+        if prev is not None:
+            d = Demand(max(d.right, prev.right), max(d.left, prev.left))
+        try:
+            part = cls.synthesise(cid, ctx, len(c.inputs), c.params, d)
+        except NotImplementedError:
+            raise DesignError(f"cell '{c.cell}' ({cls.source}) has no mechanism: implement "
+                              "synthesise() (see docs/write-a-cell.md)") from None
+        part.data["output_demand"] = d.to_json()
+        local[cid] = part
+        for net, pin in zip(c.inputs, cls.input_names(len(c.inputs))):
+            ld = part.data["input_loads"][pin]
+            add = Demand(ld["right_N"] + ctx.friction, ld["left_N"] + ctx.friction)
+            demand[net] = demand.get(net, Demand()) + add
+    return demand, local
+
+
 def _mid(t: Terminal) -> Point:
-    return ((t.off[0] + t.on[0]) / 2, (t.off[1] + t.on[1]) / 2)
+    return t.design_point

@@ -32,7 +32,7 @@ import pymunk.batch as pb
 
 from mechc.library import Library
 from mechc.mech.assemble import Mechanism
-from mechc.mech.evaluate import evaluate, signal_of
+from mechc.mech.evaluate import settle, signal_of
 from mechc.mech.kinematics import Poses
 from mechc.mech.model import GROUND, Body
 
@@ -105,7 +105,9 @@ class Scene:
     boundary: set[str] = field(default_factory=set)  # bodies driven by the closed form
     servos: dict[str, tuple[pymunk.Body, str]] = field(default_factory=dict)
     joints: list[_J] = field(default_factory=list)
+    touches: list = field(default_factory=list)  # (joint, shapes) of shape contacts
     state: dict[str, float] = field(default_factory=dict)  # current input values
+    mem_state: dict[str, float] = field(default_factory=dict)  # stateful cells (MEMORY)
 
     # ---- building ---------------------------------------------------------------------------
     @staticmethod
@@ -116,6 +118,7 @@ class Scene:
         sc.space.gravity = (0, 0)
         sc.state = dict(start)
         index = mech.body_index()
+        sc._index = index
         keep = set(sc.cells)
         parts = [mech.inputs[n] for n in mech.inputs] + [mech.cells[c] for c in sc.cells]
         own = {b.id for p in parts for b in p.bodies}
@@ -130,11 +133,13 @@ class Scene:
                 sc._add_body(b, poses, kinematic=False)
         for bid in sorted(sc.boundary):
             sc._add_body(index[bid], poses, kinematic=True)
-        for p in [mech.cells[c] for c in sc.cells]:
+        for cid in sc.cells:
+            p = mech.cells[cid]
             for j in p.joints:
                 sc._add_joint(j)
             for s in p.springs:
                 sc._add_spring(s)
+            lib[types[cid]].build_dynamics(sc, p)  # what the geometry alone cannot say
         for j in rods:
             sc._add_joint(j)
         del keep
@@ -150,7 +155,10 @@ class Scene:
         return sc
 
     def _kinematic(self, values: dict[str, np.ndarray]) -> Poses:
-        return evaluate(self.mech, self.lib, self.types, values)
+        """The closed form from the stateful cells' current states (settled per sample)."""
+        poses, state, _ = settle(self.mech, self.lib, self.types, values, self.mem_state)
+        self._last_state = {k: float(v[-1]) for k, v in state.items()}
+        return poses
 
     def _local(self, bid: str, p) -> tuple[float, float]:
         rx, ry = self.ref[bid]
@@ -162,7 +170,7 @@ class Scene:
             ref = (sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts))
         else:
             ref = b.pivot
-        if kinematic:
+        if kinematic or b.kind == "rotor":
             body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
         elif b.kind == "slider":
             body = pymunk.Body(b.mass, math.inf)
@@ -176,6 +184,13 @@ class Scene:
             u = float(poses.u[b.id][0])
             self.axis[b.id] = b.axis
             body.position = (ref[0] + u * b.axis[0], ref[1] + u * b.axis[1])
+        elif b.kind == "link":
+            tx, ty = poses.xy[b.id]
+            body.position = (ref[0] + float(np.ravel(tx)[0]), ref[1] + float(np.ravel(ty)[0]))
+            body.angle = float(poses.theta[b.id][0])
+        elif b.kind == "rotor":  # powered: turns at its set speed whatever loads it
+            body.position = ref
+            body.angular_velocity = float(b.speed or 0.0)
         else:
             body.position = ref
             body.angle = float(poses.theta[b.id][0])
@@ -183,6 +198,8 @@ class Scene:
         self.bodies[b.id] = body
         if kinematic:
             self.boundary.add(b.id)
+            return
+        if b.kind in ("link", "rotor"):  # free in the plane / driven by its motor
             return
         i = len(self.bodies) - 1
         if b.kind == "slider":
@@ -227,9 +244,40 @@ class Scene:
                                   self._anchor(j.b, j.pb), FAR, FAR + 100 * self.mech.ctx.stroke)
             self.joints.append(_J(j.id, "contact", self._idx(j.a), self._anchor(j.a, far),
                                   self._idx(j.b), self._anchor(j.b, j.pb), (FAR,)))
+        elif j.kind == "pin":
+            c = pymunk.PivotJoint(self._b(j.a), self._b(j.b), self._anchor(j.a, j.pa),
+                                  self._anchor(j.b, j.pa))
+            self.joints.append(_J(j.id, "pivot", self._idx(j.a), self._anchor(j.a, j.pa),
+                                  self._idx(j.b), self._anchor(j.b, j.pa)))
+        elif j.kind == "touch":
+            self._add_touch(j)
+            return
         else:
             raise ValueError(f"unknown joint kind {j.kind}")
         self.space.add(c)
+
+    def _add_touch(self, j) -> None:
+        """Shapes that collide only with each other (a cam and its roller, a friction roller and
+        the faces it drives); their overrun is measured like a contact's."""
+        bit = 1 << (len(self.touches) % 31)
+        filt = pymunk.ShapeFilter(group=0, categories=bit, mask=bit)
+        a, b = self._b(j.a), self._b(j.b)
+        mu = 0.0 if j.friction is None else j.friction
+        shapes: list[pymunk.Shape] = []
+        if j.profile:
+            pts = [self._anchor(j.a, p) for p in j.profile]
+            shapes += [pymunk.Segment(a, p, q, 0.0) for p, q in zip(pts, pts[1:])]
+        else:
+            shapes.append(pymunk.Circle(a, j.radius_a, self._anchor(j.a, j.pa)))
+        roller = pymunk.Circle(b, j.length, self._anchor(j.b, j.q))
+        shapes.append(roller)
+        for sh in shapes:
+            sh.filter = filt
+            sh.friction = mu  # pymunk multiplies the two shapes' values: the roller's is 1
+            sh.elasticity = 0.0
+        roller.friction = 1.0
+        self.space.add(*shapes)
+        self.touches.append((j, shapes))
 
     def _add_spring(self, s) -> None:
         c = pymunk.DampedSpring(self._b(s.a), self._b(s.b), self._anchor(s.a, s.pa),
@@ -306,22 +354,47 @@ class Scene:
             v = np.where(self._is_groove, np.hypot(off[:, 0], off[:, 1]), v)
         return v
 
+    def touch_overrun(self) -> float:
+        """Deepest interpenetration (mm) of any shape contact now."""
+        worst = 0.0
+        for _, shapes in self.touches:
+            roller = shapes[-1]
+            for sh in shapes[:-1]:
+                if not sh.bb.intersects(roller.bb):
+                    continue
+                try:
+                    points = sh.shapes_collide(roller).points
+                except AssertionError:  # pymunk 7.3 asserts on an empty contact set
+                    continue
+                for p in points:
+                    worst = max(worst, -p.distance)
+        return worst
+
+    def pose_of(self, bid: str, pos, ang) -> Poses:
+        """The scene's pose of one body in the closed form's terms (for signals)."""
+        i = self._pos[bid]
+        rx, ry = self.ref[bid]
+        if self.kind[bid] == "slider":
+            return Poses(u={bid: np.array([self.body_u(bid, pos)])})
+        p = Poses(theta={bid: np.array([ang[i]])})
+        if self.kind[bid] == "link":
+            p.xy[bid] = (np.array([pos[i, 0] - rx]), np.array([pos[i, 1] - ry]))
+        return p
+
     def body_u(self, bid: str, pos) -> float:
         i = self._pos[bid]
         rx, ry = self.ref[bid]
         ax, ay = self.axis[bid]
         return (pos[i, 0] - rx) * ax + (pos[i, 1] - ry) * ay
 
-    def outputs_now(self, pos) -> dict[str, float]:
+    def outputs_now(self, pos, ang) -> dict[str, float]:
         out = {}
         for name, (owner, pin) in self.mech.outputs.items():
             if not owner.startswith("in:") and owner not in self.cells:
                 continue
             t = self.mech.owner_part(owner).terminals[pin]
-            u = self.body_u(t.body, pos)
-            poses = Poses(u={t.body: np.array([u])})
-            b = Body(t.body, "slider", [], 0.0, axis=self.axis[t.body])
-            out[name] = float(signal_of(t, b, poses)[0])
+            out[name] = float(signal_of(t, self._index[t.body],
+                                           self.pose_of(t.body, pos, ang))[0])
         return out
 
     # ---- running ----------------------------------------------------------------------------
@@ -376,6 +449,12 @@ class Scene:
                 else:
                     th = ref.theta[bid][i0] * (1 - w) + ref.theta[bid][i0 + 1] * w
                     kb.angular_velocity = (th - kb.angle) / st.dt
+                    if self.kind[bid] == "link":
+                        rx, ry = self.ref[bid]
+                        gx = rx + ref.xy[bid][0][i0] * (1 - w) + ref.xy[bid][0][i0 + 1] * w
+                        gy = ry + ref.xy[bid][1][i0] * (1 - w) + ref.xy[bid][1][i0 + 1] * w
+                        kb.velocity = ((gx - kb.position[0]) / st.dt,
+                                       (gy - kb.position[1]) / st.dt)
             self.space.step(st.dt)
             pos, ang = self._state()
             v = self.violations(pos, ang)
@@ -385,10 +464,12 @@ class Scene:
                 if vb[i] > max_v:
                     max_v, worst = float(vb[i]), self.joints[i].id
                 max_pen = max(max_pen, float(np.max(np.where(self._is_contact, v, 0.0))))
+            if self.touches:
+                max_pen = max(max_pen, self.touch_overrun())
             bp = body.position
             lag = max(lag, math.hypot(bp[0] - servo.position[0], bp[1] - servo.position[1]))
             if step % st.record_every == 0 or step == total:
-                o = self.outputs_now(pos)
+                o = self.outputs_now(pos, ang)
                 ts.append(t)
                 k = frac * (len(samples) - 1)
                 for nm in o:
@@ -411,7 +492,8 @@ class Scene:
             if not np.isfinite(max_v):
                 break
         self.state[name] = target
-        final = final_seen[-1] if final_seen else self.outputs_now(self._state()[0])
+        self.mem_state = dict(self._last_state)
+        final = final_seen[-1] if final_seen else self.outputs_now(*self._state())
         settle = max(0.0, last_dev - st.move_time)
         if quiet_since is None and last_dev >= total * st.dt - st.record_every * st.dt * 1.5:
             settle = math.inf

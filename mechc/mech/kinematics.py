@@ -28,10 +28,13 @@ class Poses:
     """Body displacements from the design pose for N states."""
 
     u: dict[str, np.ndarray] = field(default_factory=dict)  # sliders (mm along axis)
-    theta: dict[str, np.ndarray] = field(default_factory=dict)  # levers (rad, counter-clockwise)
+    theta: dict[str, np.ndarray] = field(default_factory=dict)  # levers, links (rad, ccw)
+    xy: dict[str, tuple[np.ndarray, np.ndarray]] = field(default_factory=dict)  # links: ref
+    #                                                 point's displacement (mm)
     bad: dict[str, np.ndarray] = field(default_factory=dict)  # states where a body is unsolved
     singular_margin: dict[str, np.ndarray] = field(default_factory=dict)  # joint -> degrees
     transmission: dict[str, np.ndarray] = field(default_factory=dict)  # joint -> degrees
+    state: dict[str, np.ndarray] = field(default_factory=dict)  # stateful cell -> new state
 
     def known(self, body: str) -> bool:
         return body == GROUND or body in self.u or body in self.theta
@@ -43,7 +46,7 @@ class Poses:
             self.bad[body] = bad.copy()
 
     def update(self, other: Poses) -> None:
-        for k in ("u", "theta", "bad", "singular_margin", "transmission"):
+        for k in ("u", "theta", "xy", "bad", "singular_margin", "transmission", "state"):
             getattr(self, k).update(getattr(other, k))
 
 
@@ -61,7 +64,11 @@ def displacement(body: Body | None, poses: Poses, p: Point) -> tuple[np.ndarray,
     th = poses.theta[body.id]
     rx, ry = p[0] - body.pivot[0], p[1] - body.pivot[1]
     c, s = np.cos(th), np.sin(th)
-    return rx * c - ry * s - rx, rx * s + ry * c - ry
+    dx, dy = rx * c - ry * s - rx, rx * s + ry * c - ry
+    if body.kind == "link":
+        tx, ty = poses.xy[body.id]
+        return dx + tx, dy + ty
+    return dx, dy
 
 
 def position(body: Body | None, poses: Poses, p: Point) -> tuple[np.ndarray, np.ndarray]:
@@ -109,6 +116,8 @@ def solve(part: Part, fixed: dict[str, np.ndarray], size: int,
         (poses.u if b.kind == "slider" else poses.theta)[bid] = np.broadcast_to(
             np.asarray(u, dtype=float), (size,)).copy()
         poses.bad[bid] = np.zeros(size, dtype=bool)
+        if b.kind == "link":
+            raise KinematicsError(f"{bid}: a free link cannot be an input terminal")
     todo = [b for b in part.bodies if b.id not in fixed]
     by_body: dict[str, list[Joint]] = {}
     for j in part.joints:
@@ -117,7 +126,7 @@ def solve(part: Part, fixed: dict[str, np.ndarray], size: int,
     while todo:
         progress = False
         for b in list(todo):
-            if _try_solve(part, b, bodies, by_body.get(b.id, []), poses, size):
+            if poses.known(b.id) or _try_solve(part, b, bodies, by_body, poses, size):
                 todo.remove(b)
                 progress = True
         if not progress:
@@ -132,7 +141,9 @@ def _get(bodies, bid):
     return None if bid == GROUND else bodies[bid]
 
 
-def _try_solve(part, b: Body, bodies, joints: list[Joint], poses: Poses, size: int) -> bool:
+def _try_solve(part, b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
+               size: int) -> bool:
+    joints = by_body.get(b.id, [])
     # 1) bilateral joints to an already known body
     for j in joints:
         other = j.b if j.a == b.id else j.a
@@ -151,6 +162,8 @@ def _try_solve(part, b: Body, bodies, joints: list[Joint], poses: Poses, size: i
         if j.kind == "rod" and b.kind == "lever":
             _lever_from_rod(j, b, _get(bodies, other), poses, size)
             return True
+    if b.kind in ("lever", "link") and _try_dyad(b, bodies, by_body, poses, size):
+        return True
     if b.kind != "slider":
         return False
     # 2) a slider held only by contacts: all the other bodies must be known
@@ -190,6 +203,78 @@ def _try_solve(part, b: Body, bodies, joints: list[Joint], poses: Poses, size: i
     poses.u[b.id] = np.where(jam, np.nan, u)
     poses.mark(b.id, bad | jam)
     return True
+
+
+def _anchor(b: Body, joints: list[Joint], bodies, poses: Poses):
+    """The point ``b`` turns about: its ground pivot (lever) or a pin to a known body (link).
+    Returns (design point, world x, world y, bad, joint) or None."""
+    if b.kind == "lever":
+        return b.pivot, np.asarray(b.pivot[0]), np.asarray(b.pivot[1]), None, None
+    for j in joints:
+        if j.kind != "pin":
+            continue
+        other = j.b if j.a == b.id else j.a
+        if poses.known(other):
+            x, y = position(_get(bodies, other), poses, j.pa)
+            return j.pa, x, y, poses.bad.get(other), j
+    return None
+
+
+def _try_dyad(b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
+              size: int) -> bool:
+    """Two bodies joined by a pin, each turning about a known point (a lever's pivot or a pin
+    to a solved body): the pin is where the two circles meet, on the design pose's side."""
+    joints = by_body.get(b.id, [])
+    mine = _anchor(b, joints, bodies, poses)
+    if mine is None:
+        return False
+    for j in joints:
+        if j.kind != "pin" or j is mine[4]:
+            continue
+        other_id = j.b if j.a == b.id else j.a
+        if other_id == GROUND or poses.known(other_id):
+            continue
+        c = bodies[other_id]
+        if c.kind not in ("lever", "link"):
+            continue
+        theirs = _anchor(c, [k for k in by_body.get(c.id, []) if k is not j], bodies, poses)
+        if theirs is None:
+            continue
+        P0 = j.pa
+        (A0, ax, ay, abad, _), (B0, bx, by, bbad, _) = mine, theirs
+        r1 = float(np.hypot(P0[0] - A0[0], P0[1] - A0[1]))
+        r2 = float(np.hypot(P0[0] - B0[0], P0[1] - B0[1]))
+        dx, dy = bx - ax, by - ay
+        d = np.hypot(dx, dy)
+        a = (r1 * r1 - r2 * r2 + d * d) / (2 * np.where(d > 0, d, 1.0))
+        h2 = r1 * r1 - a * a
+        ok = np.broadcast_to((h2 >= 0) & (d > 0), (size,))
+        h = np.sqrt(np.where(h2 >= 0, h2, 0.0))
+        side = float(np.sign(_cross((B0[0] - A0[0], B0[1] - A0[1]),
+                                    (P0[0] - A0[0], P0[1] - A0[1])))) or 1.0
+        ex, ey = dx / np.where(d > 0, d, 1.0), dy / np.where(d > 0, d, 1.0)
+        px, py = ax + a * ex - side * h * ey, ay + a * ey + side * h * ex
+        bad = ~ok
+        for x in (abad, bbad):
+            if x is not None:
+                bad = bad | np.broadcast_to(x, (size,))
+        for body, (Q0, qx, qy) in ((b, (A0, ax, ay)), (c, (B0, bx, by))):
+            th = (np.arctan2(py - qy, px - qx) - np.arctan2(P0[1] - Q0[1], P0[0] - Q0[0]))
+            th = (th + np.pi) % (2 * np.pi) - np.pi
+            poses.theta[body.id] = np.where(ok, th, np.nan) * np.ones(size)
+            if body.kind == "link":  # the anchor point moves to (qx, qy): carry the ref
+                cs, sn = np.cos(th), np.sin(th)
+                rx, ry = body.pivot[0] - Q0[0], body.pivot[1] - Q0[1]
+                tx = qx + rx * cs - ry * sn - body.pivot[0]
+                ty = qy + rx * sn + ry * cs - body.pivot[1]
+                poses.xy[body.id] = (np.where(ok, tx, np.nan) * np.ones(size),
+                                     np.where(ok, ty, np.nan) * np.ones(size))
+            poses.mark(body.id, bad)
+        gamma = _angle_between_lines(px - ax, py - ay, px - bx, py - by)
+        poses.transmission[j.id] = gamma * np.ones(size)
+        poses.singular_margin[j.id] = gamma * np.ones(size)
+        return True
+    return False
 
 
 def _lever_from_slot(j: Joint, lever: Body, slot_body: Body, poses: Poses, size: int):
@@ -334,6 +419,10 @@ def _check_consistency(part: Part, bodies, poses: Poses, size: int, tol: float =
             bx_, by_ = position(b, poses, j.pb)
             viol = np.broadcast_to(np.abs(np.hypot(bx_ - ax_, by_ - ay_) - j.length) > 1e-6,
                                    (size,))
+        elif j.kind == "pin":
+            ax_, ay_ = position(a, poses, j.pa)
+            bx_, by_ = position(b, poses, j.pa)
+            viol = np.broadcast_to(np.hypot(bx_ - ax_, by_ - ay_) > 1e-6, (size,))
         elif j.kind == "groove":
             d = _unit((j.p1[0] - j.p0[0], j.p1[1] - j.p0[1]))
             x0, y0 = position(a, poses, j.p0)

@@ -26,7 +26,8 @@ def _r(p: Point | None, nd: int = 4):
 @dataclass
 class Body:
     id: str
-    kind: str  # "slider" (translates along axis) | "lever" (turns about pivot)
+    kind: str  # "slider" (along axis) | "lever" (turns about pivot) | "link" (free in the
+    #            plane; pivot is its reference point) | "rotor" (powered: turns at `speed`)
     outline: list[list[Point]]  # polygons, world mm at the design pose
     mass: float  # kg
     axis: Point | None = None  # slider: unit direction of travel, off -> on
@@ -34,6 +35,7 @@ class Body:
     layer: int = 0  # plane (parts on different layers may cross)
     role: str = ""
     poly_layers: list[int] | None = None  # per polygon, where pieces sit on other planes
+    speed: float | None = None  # rotor: rad/s, counter-clockwise positive
 
     def layer_of(self, i: int) -> int:
         return self.poly_layers[i] if self.poly_layers else self.layer
@@ -48,6 +50,8 @@ class Body:
             d["axis"] = _r(self.axis, 6)
         if self.pivot is not None:
             d["pivot"] = _r(self.pivot)
+        if self.speed is not None:
+            d["speed_rad_s"] = round(self.speed, 6)
         return d
 
     @staticmethod
@@ -55,7 +59,8 @@ class Body:
         return Body(d["id"], d["kind"], [[_pt(p) for p in poly] for poly in d["outline"]],
                     float(d["mass_kg"]), _pt(d["axis"]) if d.get("axis") else None,
                     _pt(d["pivot"]) if d.get("pivot") else None, int(d.get("layer", 0)),
-                    d.get("role", ""), d.get("poly_layers"))
+                    d.get("role", ""), d.get("poly_layers"),
+                    float(d["speed_rad_s"]) if d.get("speed_rad_s") is not None else None)
 
 
 @dataclass
@@ -67,6 +72,11 @@ class Joint:
     - ``contact``: one-sided: the faces at ``pa`` (on a) and ``pb`` (on b) keep
       ``(pb - pa) . normal >= 0`` (a stop is a contact with the ground). ``driven`` names the
       body the contact positions (the other side's spring budget is the stronger one).
+    - ``pin``: a and b turn about one shared point ``pa`` (a revolute pair between two bodies).
+    - ``touch``: a shape contact with friction: on a, the polyline ``profile`` (a cam, a face) or
+      a circle of ``radius_a`` about ``pa``; on b, a roller of radius ``length`` about ``q``.
+      Used where the contact point travels (cams, friction rollers); the cell that owns it
+      supplies the kinematics.
     """
 
     id: str
@@ -81,9 +91,18 @@ class Joint:
     normal: Point | None = None
     length: float | None = None
     driven: str | None = None
+    profile: list[Point] | None = None
+    radius_a: float | None = None
+    friction: float | None = None
 
     def to_json(self) -> dict:
         d = {"id": self.id, "kind": self.kind, "a": self.a, "b": self.b}
+        if self.profile is not None:
+            d["profile"] = [_r(p) for p in self.profile]
+        if self.radius_a is not None:
+            d["radius_a_mm"] = round(self.radius_a, 4)
+        if self.friction is not None:
+            d["friction"] = round(self.friction, 4)
         if self.driven is not None:
             d["driven"] = self.driven
         for k in ("p0", "p1", "q", "pa", "pb"):
@@ -102,7 +121,10 @@ class Joint:
                      *(_pt(d[k]) if d.get(k) is not None else None
                        for k in ("p0", "p1", "q", "pa", "pb", "normal")),
                      float(d["length_mm"]) if d.get("length_mm") is not None else None,
-                     d.get("driven"))
+                     d.get("driven"),
+                     [_pt(p) for p in d["profile"]] if d.get("profile") else None,
+                     float(d["radius_a_mm"]) if d.get("radius_a_mm") is not None else None,
+                     float(d["friction"]) if d.get("friction") is not None else None)
 
 
 @dataclass
@@ -141,15 +163,25 @@ class Terminal:
     kind: str  # "translating" | "rotating"
     off: Point
     on: Point
+    at: Point | None = None  # the point at the design pose, when not midway (a toggle's throw)
+
+    @property
+    def design_point(self) -> Point:
+        if self.at is not None:
+            return self.at
+        return ((self.off[0] + self.on[0]) / 2, (self.off[1] + self.on[1]) / 2)
 
     def to_json(self) -> dict:
-        return {"pin": self.pin, "body": self.body, "kind": self.kind, "off": _r(self.off),
-                "on": _r(self.on)}
+        d = {"pin": self.pin, "body": self.body, "kind": self.kind, "off": _r(self.off),
+             "on": _r(self.on)}
+        if self.at is not None:
+            d["at"] = _r(self.at)
+        return d
 
     @staticmethod
     def from_json(d: dict) -> Terminal:
         return Terminal(d["pin"], d["body"], d.get("kind", "translating"), _pt(d["off"]),
-                        _pt(d["on"]))
+                        _pt(d["on"]), _pt(d["at"]) if d.get("at") else None)
 
 
 @dataclass
@@ -168,10 +200,10 @@ class Check:
         v = self.value
         if v != v:  # NaN never passes
             return False
-        return v >= self.limit if self.sense == ">=" else v <= self.limit
+        return bool(v >= self.limit if self.sense == ">=" else v <= self.limit)
 
     def to_json(self) -> dict:
-        return {"name": self.name, "where": self.where, "value": round(self.value, 4),
+        return {"name": self.name, "where": self.where, "value": round(float(self.value), 4),
                 "limit": self.limit, "sense": self.sense, "unit": self.unit,
                 "passed": self.passed}
 

@@ -47,6 +47,10 @@ def _connector(x, p):
     return ~x[0] if p.get("logic", "identity") == "invert" else x[0]
 
 
+def _memory(x, p):
+    raise TypeError("MEMORY is stateful: evaluate it with the sequential simulator")
+
+
 def _const(x, p, size=None):
     raise AssertionError("CONST is evaluated by the caller (it has no inputs)")
 
@@ -67,6 +71,8 @@ TYPES: dict[str, LogicType] = {t.name: t for t in [
               doc="multithreshold: output flips at each threshold the weighted sum crosses"),
     LogicType("CONNECTOR", 1, 1, _connector, doc="link, shaft or lever: identity or invert"),
     LogicType("AMPLIFIER", 1, 1, lambda x, p: x[0], doc="power amplifier (identity)"),
+    LogicType("MEMORY", 2, 2, _memory, commutative=False,
+              doc="set/reset memory: Q on after S, off after R, held while both off (stateful)"),
     LogicType("CONST", 0, 0, _const, doc="a terminal fixed at off or on (params.value)"),
 ]}
 

@@ -31,7 +31,7 @@ MAX_LISTED = 50
 
 def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
           inputs_order: list[str] | None = None, stats: CheckStats | None = None,
-          budget: int = 4_000_000, sample: int = 512, max_states: int | None = None):
+          budget: int = 20_000_000, sample: int = 512, max_states: int | None = None):
     """Evaluate rest states and single-input changes (``samples`` points along the moving
     input), in chunks so memory stays bounded; returns output signals only, and feeds the
     design-check statistics ``stats`` as it goes.
