@@ -1,0 +1,303 @@
+"""AMPLIFIER: a bistable toggle switched by powered friction rollers (001 §2.6, Fig. 17).
+
+Two rollers R1, R2 turn continuously (R1 counter-clockwise, R2 clockwise here; Fig. 17 is this
+layout mirrored). The input slider S carries two friction rollers F1, F2, each floating in a
+short slot and pressed towards its wedge by a light spring. The output toggle T turns about Q;
+its cylindrical surface C (radius ``Rc`` about Q) has a relief I. When A goes on, F1 enters the
+wedge between R1 and C: R1's friction drags F1 deeper into the wedge, which gives the normal
+force, and F1, an idler, turns C (and T) counter-clockwise. Just before T reaches its stop Sp1
+the relief comes under F1 and the drive stops; momentum and the over-centre toggle spring carry
+T onto Sp1. Going off, F2, R2 and Sp2 do the same the other way. A crank pin on T and a rod turn
+T's swing into the output slider's stroke.
+
+Because the rollers and C are cylinders about fixed centres, the wedge keeps its shape while T
+turns, and nothing but F's spring and the slider guide resists the input: the input force is
+about its slider friction, the output force comes from the motor.
+
+Kinematic model (quasi-static): T rests on the stop its input state selects (off below half
+stroke, on from half stroke), the output slider follows the crank closed form, F1/F2 follow the
+slider until their wedge stops them. The switching itself is only in the dynamic model.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from mechc.cell import Cell
+from mechc.errors import DesignError
+from mechc.mech.build import Builder, Demand, SynthContext, rect
+from mechc.mech.kinematics import solve
+from mechc.mech.model import GROUND, Body, Joint, Part, Point, Spring
+
+#: A table computed once by ``python benchmarks/amplifier.py`` (pymunk, default SynthContext
+#: and DynSettings: stroke 20 mm, rollers at 60 rad/s) and re-measured by
+#: tests/test_amplifier.py; stored in every instance's part.data for the mapper and the
+#: sequential proof. Delay: input at 95 % of its stroke -> output within 5 % of its new end
+#: (worst of on and off). Fan-out: OR inputs driven with prove_dynamic passing (4 fails).
+MEASURED = {
+    "switching_delay_s": 0.048,
+    "fanout_max": 3,
+}
+
+
+@dataclass(frozen=True)
+class AmpDesign:
+    """The numbers that fix an amplifier (mm, N, rad, rad/s)."""
+
+    stroke: float
+    r_f: float  # friction roller radius
+    r_r: float  # powered roller radius
+    rc: float  # radius of the cylindrical surface C
+    beta: float  # F's contact on C, from the top of C (rad): also half the relief travel
+    gamma: float  # F's contact on R, from the vertical (rad)
+    coast: float  # T's coast from the relief to its stop (rad)
+    relief_depth: float
+    r_o: float  # crank radius
+    rod: float  # crank rod length
+    theta_on: float  # T's stops, from the design pose (output at half stroke)
+    theta_off: float
+    engage: float  # slider travel short of its end at which F meets its wedge
+    slot: float  # F's slot length
+    play: float  # F's free play across its slot (each way)
+    press: float  # F's spring force at its slot end (N)
+    press_rate: float  # N/mm
+    mu: float  # roller friction coefficient
+    speed: float  # powered roller speed (rad/s)
+    toggle_e: float  # toggle spring: radius of its point on T (above Q at design)
+    toggle_g: float  # distance of its ground anchor below Q
+    toggle_rate: float  # N/mm
+    toggle_rest: float  # mm
+    toggle_damping: float  # damping ratio of T on its toggle spring
+    hold_required: float  # N mm, torque T must hold on either stop
+    hold_torque: float  # N mm, the toggle spring's torque at the weaker stop
+
+
+def crank_u(theta, r_o: float, rod: float):
+    """Output slider travel for T at ``theta`` (crank pin below Q at theta = 0, rod level)."""
+    dy = r_o * (1.0 - np.cos(theta))
+    return r_o * np.sin(theta) + np.sqrt(rod * rod - dy * dy) - rod
+
+
+def toggle_torque(theta, d: AmpDesign):
+    """Counter-clockwise torque (N mm) of the over-centre spring on T at ``theta``."""
+    e, g = d.toggle_e, d.toggle_g
+    length = np.sqrt(e * e + g * g + 2 * e * g * np.cos(theta))
+    return d.toggle_rate * (length - d.toggle_rest) * e * g * np.sin(theta) / length
+
+
+def design(ctx: SynthContext, demand: Demand, params: dict | None = None) -> AmpDesign:
+    """Dimensions from the stroke, and the toggle spring from what the output must hold."""
+    p = params or {}
+    S = ctx.stroke
+    beta = math.radians(p.get("beta_deg", 15.0))
+    coast = math.radians(p.get("coast_deg", 5.0))
+    half = beta  # T swings ±beta: the relief travels from F2 to F1 (2 beta)
+    r_o = S / (2.0 * math.sin(half))
+    rod = p.get("rod", 1.0 * S)
+    # stops where the output is exactly at its ends (the crank is a hair asymmetric)
+    theta_on = brentq(lambda t: crank_u(t, r_o, rod) - S / 2, 0.0, 2 * half)
+    theta_off = brentq(lambda t: crank_u(t, r_o, rod) + S / 2, -2 * half, 0.0)
+    e, g = 0.5 * 1.6 * S, 1.0 * S
+    arm_on = r_o * math.cos(theta_on)  # moment arm of a level rod force about Q
+    arm_off = r_o * math.cos(theta_off)
+    need = max((demand.right + ctx.friction) * arm_on, (demand.left + ctx.friction) * arm_off)
+    need = max(need, ctx.min_preload * arm_on)
+    hold_required = ctx.margin * need
+    # spring: tension at the stops T_s with 30 % rise towards dead centre (k * dL = 0.3 T_s)
+    l_stop = math.sqrt(e * e + g * g + 2 * e * g * math.cos(max(theta_on, -theta_off)))
+    l_mid = e + g
+    geo = e * g * min(math.sin(theta_on), -math.sin(theta_off)) / l_stop
+    tension = hold_required / geo
+    rate = ctx.spring_range * tension / (l_mid - l_stop)
+    rest = l_stop - tension / rate
+    d = AmpDesign(S, 0.2 * S, 0.25 * S, 1.6 * S, beta, math.radians(p.get("gamma_deg", 15.0)),
+                  coast, 0.1 * S, r_o, rod, theta_on, theta_off, 0.025 * S, 0.075 * S, 0.0125 * S,
+                  p.get("press_N", 0.1), p.get("press_rate", 0.02), p.get("mu", 0.6),
+                  p.get("speed", 60.0), e, g, rate, rest, p.get("toggle_damping", 0.3),
+                  hold_required, 0.0)
+    hold = min(float(toggle_torque(theta_on, d)), -float(toggle_torque(theta_off, d)))
+    d = AmpDesign(**{**d.__dict__, "hold_torque": hold})
+    if hold < hold_required * (1 - 1e-9):
+        raise DesignError(f"amplifier toggle spring holds {hold:.4g} N mm, needs "
+                          f"{hold_required:.4g} N mm")
+    return d
+
+
+def rated_force(d: AmpDesign, ctx: SynthContext) -> float:
+    """Largest level force on the output slider the toggle spring holds on either stop
+    (static: no margin), net of the output slider's guide friction."""
+    on = float(toggle_torque(d.theta_on, d)) / (d.r_o * math.cos(d.theta_on))
+    off = -float(toggle_torque(d.theta_off, d)) / (d.r_o * math.cos(d.theta_off))
+    return min(on, off) - ctx.friction
+
+
+def _arc(c: Point, r: float, a0: float, a1: float, step: float = math.radians(2.0)):
+    n = max(1, int(math.ceil(abs(a1 - a0) / step)))
+    return [(c[0] + r * math.cos(a), c[1] + r * math.sin(a)) for a in np.linspace(a0, a1, n + 1)]
+
+
+def _disc(c: Point, r: float, n: int = 16) -> list[Point]:
+    return [(c[0] + r * math.cos(a), c[1] + r * math.sin(a))
+            for a in np.linspace(0, 2 * math.pi, n, endpoint=False)]
+
+
+STOP_ERROR_BIAS = 0.1 ** 60  # pymunk: fraction of a joint error left after 1 s
+
+
+class Amplifier(Cell):
+    name = "amplifier"
+    type = "AMPLIFIER"
+    min_inputs = 1
+    max_inputs = 1
+    description = ("powered friction rollers switch a bistable toggle: input force ~ slider "
+                   "friction (Fig. 17)")
+
+    @classmethod
+    def cost(cls, n_inputs: int) -> int:
+        # input slider, F1, F2, R1, R2, toggle T, output slider, toggle spring, 2 press springs
+        return 10
+
+    @classmethod
+    def synthesise(cls, cid, ctx, n_inputs, params, demand):
+        d = design(ctx, demand, params)
+        b = Builder(cid, ctx)
+        S, w = ctx.stroke, ctx.bar
+        rho = d.rc + d.r_f  # distance Q -> roller centre when it touches C
+        sb, cb = math.sin(d.beta), math.cos(d.beta)
+        sg, cg = math.sin(d.gamma), math.cos(d.gamma)
+        x1_design = 1.2 * S  # F1 on the slider at the design pose (slot end)
+        x_w1 = x1_design + S / 2 - d.engage  # where F1 meets its wedge (slider short by engage)
+        Q = (x_w1 + rho * sb, -rho * cb)
+        x_w2 = Q[0] + rho * sb
+        x2_design = x_w2 + S / 2 - d.engage
+        y = 0.0
+        # ---- input slider with the two floating friction rollers ----------------------------
+        sig = b.input_slider("A", 0.0, y, x2_design + d.slot + 0.5 * S)
+        slider = sig.body
+        f1, f2 = b.name("F1"), b.name("F2")
+        for fid, xd in ((f1, x1_design), (f2, x2_design)):
+            poly = _disc((xd, y), d.r_f)
+            b.part.bodies.append(Body(fid, "link", [poly], ctx.mass([poly]), pivot=(xd, y),
+                                      layer=2, role="friction roller"))
+        # each roller floats in a hole of the slider: one-sided stops bound it along x (a slot
+        # of length ``slot``) and across (± ``play``), a light spring presses it towards its
+        # wedge (F1 right, F2 left). Free in the plane inside that hole, the two contacts of
+        # the wedge alone decide its normal forces (a tight 1-DOF carrier would take them).
+        for fid, xd, sense in ((f1, x1_design, -1), (f2, x2_design, 1)):
+            limits = (((xd, y), (float(sense), 0.0)), ((xd + sense * d.slot, y),
+                                                       (-float(sense), 0.0)),
+                      ((xd, y - d.play), (0.0, 1.0)), ((xd, y + d.play), (0.0, -1.0)))
+            for at, n in limits:
+                b.part.joints.append(Joint(b._id("hole"), "contact", slider, fid, pa=at,
+                                           pb=(xd, y), normal=n, driven=fid))
+            m = b.part.body(fid).mass
+            anchor = (xd + sense * 0.5 * S, y)
+            rest = 0.5 * S + d.press / d.press_rate
+            damping = 2 * ctx.damping_ratio * math.sqrt(d.press_rate * 1000.0 * m) / 1000.0
+            b.part.springs.append(Spring(b._id("press"), slider, fid, anchor, (xd, y),
+                                         d.press_rate, rest, damping, d.press))
+        # ---- powered rollers ---------------------------------------------------------------
+        r1c = (x_w1 + (d.r_f + d.r_r) * sg, y + (d.r_f + d.r_r) * cg)
+        r2c = (x_w2 - (d.r_f + d.r_r) * sg, y + (d.r_f + d.r_r) * cg)
+        r1, r2 = b.name("R1"), b.name("R2")
+        for rid, c, sp, layer in ((r1, r1c, d.speed, 3), (r2, r2c, -d.speed, 4)):
+            poly = _disc(c, d.r_r)
+            b.part.bodies.append(Body(rid, "rotor", [poly], ctx.mass([poly]), pivot=c,
+                                      layer=layer, role="powered roller", speed=sp))
+        # ---- toggle T: surface C with its relief, crank arm, stop lug -----------------------
+        t_id = b.name("T")
+        lead = math.pi / 2 + d.beta - d.theta_on + d.coast  # relief edges (T frame, design)
+        trail = math.pi / 2 - d.beta - d.theta_off - d.coast
+        margin = math.radians(8.0)
+        lo = math.pi / 2 - d.beta - d.theta_on - margin
+        hi = math.pi / 2 + d.beta - d.theta_off + margin
+        profile = (_arc(Q, d.rc, lo, trail) + _arc(Q, d.rc - d.relief_depth, trail, lead)
+                   + _arc(Q, d.rc, lead, hi))
+        sector = [Q, *profile]
+        pin = (Q[0], Q[1] - d.r_o)
+        arm = rect(Q[0] - w / 2, pin[1] - w / 2, Q[0] + w / 2, Q[1])
+        b.part.bodies.append(Body(t_id, "lever", [sector, arm], ctx.mass([sector, arm]),
+                                  pivot=Q, layer=2, role="output toggle"))
+        mu = d.mu
+        for fid in (f1, f2):
+            b.part.joints.append(Joint(b._id("touch"), "touch", t_id, fid, q=b.part.body(
+                fid).pivot, length=d.r_f, profile=profile, friction=mu))
+        for rid, c, fid in ((r1, r1c, f1), (r2, r2c, f2)):
+            b.part.joints.append(Joint(b._id("touch"), "touch", rid, fid, pa=c, radius_a=d.r_r,
+                                       q=b.part.body(fid).pivot, length=d.r_f, friction=mu))
+        # stops Sp1 (on) and Sp2 (off) against the crank pin's lug
+        for th, n in ((d.theta_on, (-1.0, 0.0)), (d.theta_off, (1.0, 0.0))):
+            face = (Q[0] + d.r_o * math.sin(th), Q[1] - d.r_o * math.cos(th))
+            b.part.joints.append(Joint(b._id("stop"), "contact", GROUND, t_id, pa=face,
+                                       pb=pin, normal=n, driven=t_id))
+        # over-centre toggle spring: point E above Q on T, anchor G below Q
+        E, G = (Q[0], Q[1] + d.toggle_e), (Q[0], Q[1] - d.toggle_g)
+        i_t = b.part.body(t_id).mass * (0.5 * d.rc) ** 2
+        omega = math.sqrt(d.toggle_rate * 1000.0 * (d.toggle_e ** 2) / i_t)
+        damping = d.toggle_damping * 2 * i_t * omega / d.toggle_e ** 2 / 1000.0
+        b.part.springs.append(Spring(b._id("toggle"), GROUND, t_id, G, E, d.toggle_rate,
+                                     d.toggle_rest, damping, d.hold_torque))
+        # ---- output: rod from the crank pin to the output slider ---------------------------
+        x_pin = pin[0] + d.rod
+        out = b.slider("out", x_pin - w / 2, x_pin + 0.8 * S, pin[1], "AMPLIFIER output")
+        b.rod(t_id, out.body, pin, (x_pin, pin[1]))
+        b.output(out, "Z")
+        b.part.data.update({
+            "design": {k: float(v) for k, v in d.__dict__.items()},
+            "rated_output_force_N": round(rated_force(d, ctx), 4),
+            "switching_delay_s": MEASURED["switching_delay_s"],
+            "fanout_max": MEASURED["fanout_max"],
+            "figures_source": "benchmarks/amplifier.py (dynamic pymunk, stroke 20 mm), "
+                              "re-measured in tests/test_amplifier.py",
+        })
+        load = Demand(d.press + d.press_rate * d.engage, d.press + d.press_rate * d.engage)
+        return b.finish({"A": load})
+
+    @classmethod
+    def build_dynamics(cls, scene, part: Part) -> None:
+        """pymunk multiplies the two shapes' friction coefficients: make the roller's 1 so a
+        touch's contact has the friction its joint says."""
+        mine = {j.id for j in part.joints if j.kind == "touch"}
+        for j, shapes in scene.touches:
+            if j.id in mine:
+                shapes[-1].friction = 1.0
+        # T lands on its stop at speed: correct the overrun within milliseconds, not pymunk's
+        # default 1/6 s (a slow creep back reads as an output that has not settled)
+        toggle = next(b.id for b in part.bodies if b.role == "output toggle")
+        tb = scene.bodies[toggle]
+        for c in scene.space.constraints:
+            if tb in (c.a, c.b):
+                c.error_bias = STOP_ERROR_BIAS
+
+    @classmethod
+    def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):
+        """Quasi-static states: T on the stop the input selects (switching is dynamic)."""
+        d = part.data["design"]
+        S = d["stroke"]
+        by_role = {}
+        for body in part.bodies:
+            by_role.setdefault(body.role, []).append(body)
+        slider = next(bd for bd in part.bodies if bd.role == "input A")
+        tog = by_role["output toggle"][0]
+        out = by_role["AMPLIFIER output"][0]
+        u = np.broadcast_to(np.asarray(fixed[slider.id], dtype=float), (size,)).copy()
+        theta = np.where(u >= 0.0, d["theta_on"], d["theta_off"])
+        rod = next(j for j in part.joints if j.kind == "rod")
+        sub = Part([tog, out], [rod])
+        poses = solve(sub, {tog.id: theta}, size)
+        poses.u[slider.id] = u
+        poses.bad[slider.id] = ~np.isfinite(u)
+        f1, f2 = by_role["friction roller"]
+        reach = S / 2 - d["engage"]
+        for f, du in ((f1, np.minimum(u, reach)), (f2, np.maximum(u, -reach))):
+            poses.theta[f.id] = np.zeros(size)
+            poses.xy[f.id] = (du, np.zeros(size))
+            poses.bad[f.id] = np.zeros(size, dtype=bool)
+        for r in by_role["powered roller"]:
+            poses.theta[r.id] = np.zeros(size)
+            poses.bad[r.id] = np.zeros(size, dtype=bool)
+        return poses
