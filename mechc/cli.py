@@ -71,7 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
                        "map to library cells, place them, and write the design as JSON. The "
                        "output file is written atomically: on any error an existing file is "
                        "left untouched.")
-    c.add_argument("spec", help="specification file (.bool, .pla)")
+    c.add_argument("spec", help="specification file (.bool, .pla, .fsm)")
     c.add_argument("-o", "--output", help="output JSON file (default: SPEC with .json suffix)")
     _compile_options(c)
     c.add_argument("--timings", action="store_true",
@@ -112,6 +112,12 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
                    help="dynamic: solver iterations per step (default 60)")
     s.add_argument("--move-time", type=float, default=None, metavar="S",
                    help="dynamic: seconds an input takes to move (default 0.08)")
+    s.add_argument("--prune", action="store_true",
+                   help="dynamic: run each input change on a scene of only the cells it can "
+                   "move (see docs/performance.md)")
+    s.add_argument("--accuracy", type=float, default=None, metavar="F",
+                   help="dynamic: the cheapest settings (from the measured error model) whose "
+                   "output error is at most F of stroke, confirmed on the run by step halving")
     s.add_argument("--spec", metavar="OTHER",
                    help="prove against this spec instead of the one the design was compiled from")
     s.add_argument("--report", metavar="FILE.json", help="write the proof report as JSON")
@@ -128,6 +134,7 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
 
     _register_optional(sub, "mechc.draw")  # mechc draw ...
     _register_optional(sub, "mechc.synthesis.cli")  # mechc synth ...
+    _register_optional(sub, "mechc.bench.speed_accuracy")  # mechc bench ...
     return p
 
 
@@ -148,6 +155,9 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
     g = c.add_argument_group("compilation")
     g.add_argument("--cells", dest="cell_dirs", action="append", default=[], metavar="DIR",
                    help="extra directory of cell files (repeatable; also MECHC_CELLS)")
+    g.add_argument("--use-cell", dest="use_cell", action="append", default=[], metavar="NAME",
+                   help="use library cell NAME wherever it fits, also one the mapper does not "
+                   "choose by itself (e.g. three_bar_and; repeatable)")
     g.add_argument("--fan-in", type=_positive_int(2), default=None, metavar="N",
                    help="at most N inputs per AND/OR/NAND/NOR cell (default: the library's)")
     g.add_argument("--time-limit", type=float, default=20.0, metavar="S",
@@ -156,6 +166,10 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
     g.add_argument("--phase", choices=["auto", "sop"], default="auto",
                    help="auto: also try complement (NOR/NAND root) and XOR forms and keep the "
                    "cheapest; sop: sums of products only (default: %(default)s)")
+    g.add_argument("--map", dest="map_target", choices=["conventional", "threshold", "auto"],
+                   default="conventional",
+                   help="threshold: outputs of up to 3 inputs as THRESHOLD generators (001 Ch. "
+                   "III); auto: only where that costs fewer parts (default: %(default)s)")
     g.add_argument("--no-share", action="store_true",
                    help="do not share product terms between outputs")
     g.add_argument("--keep-hazards", action="store_true",
@@ -200,7 +214,9 @@ def _options(args):
                                  complements=args.phase == "auto",
                                  hazard_free=not args.keep_hazards),
         map=MapOptions(fan_in=args.fan_in, phase=args.phase,
-                       hazard_free=not args.keep_hazards),
+                       hazard_free=not args.keep_hazards,
+                       prefer=tuple(getattr(args, "use_cell", ())),
+                       target=getattr(args, "map_target", "conventional")),
         mech=MechOptions(stroke=args.stroke, actuator_force=args.actuator_force,
                          output_load=args.output_load),
         cell_dirs=tuple(args.cell_dirs),
@@ -208,11 +224,23 @@ def _options(args):
     )
 
 
-def _compile(spec_path: str, args):
-    from mechc.pipeline import compile_spec
+def _load_spec(spec_path: str):
+    """The one place a spec file is read: .fsm (sequential) here, the others in mechc.spec."""
+    if str(spec_path).lower().endswith(".fsm"):
+        from mechc.spec.fsm import parse_fsm_file
+
+        return parse_fsm_file(spec_path)
     from mechc.spec import load_spec
 
-    spec = load_spec(spec_path)
+    return load_spec(spec_path)
+
+
+def _compile(spec_path: str, args, mechanism: bool = True):
+    from mechc.pipeline import compile_sequential, compile_spec
+
+    spec = _load_spec(spec_path)
+    if not mechanism and getattr(spec, "kind", "") == "fsm":
+        return compile_sequential(spec, _options(args), mechanism=False)
     return compile_spec(spec, _options(args))
 
 
@@ -242,6 +270,14 @@ def cmd_compile(args) -> int:
         print(f"  {o} = {design.equations[o]}")
         if design.implemented.get(o) and design.implemented[o] != design.equations[o]:
             print(f"  {' ' * len(o)}   built as {design.implemented[o]}")
+    se = getattr(design, "sequential", None)
+    if se is not None:
+        for m in se.memories:
+            print(f"  MEMORY {m}: set = {se.text(se.set_names[m])}, reset = "
+                  f"{se.text(se.reset_names[m])}, initial {se.initial[m]}")
+        for h in se.essential_hazards:
+            print(f"  essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
+                  f"{h['to']}: {h['requires']}")
     if args.print_netlist:
         print(design.netlist.to_text(), end="")
     dc = st.get("design_checks", {})
@@ -266,12 +302,12 @@ def load_design_or_spec(path: str, args):
 
     if path.lower().endswith(".json"):
         return design_from_json(load_design_json(path), path)
-    return _compile(path, args)
+    # a logic proof of a sequential spec needs the netlist only, not the mechanism
+    return _compile(path, args, mechanism=getattr(args, "level", None) != "logic")
 
 
 def cmd_simulate(args) -> int:
     from mechc.library import load_library
-    from mechc.spec import load_spec
     from mechc.writer import dumps, write_atomic
 
     if not 0 < args.tolerance < 0.5:
@@ -279,9 +315,17 @@ def cmd_simulate(args) -> int:
     if args.cases < 0:
         raise UsageError("--cases must not be negative")
     design = load_design_or_spec(args.design, args)
-    spec = load_spec(args.spec) if args.spec else design.spec
+    spec = _load_spec(args.spec) if args.spec else design.spec
+    sequential = getattr(spec, "kind", "") == "fsm"
+    if sequential != any(c.type == "MEMORY" for c in design.netlist.cells.values()):
+        raise UsageError("a sequential design (with MEMORY cells) is proved against a .fsm spec "
+                         "and a combinational one against a .bool/.pla spec")
     lib = load_library(args.cell_dirs)
-    if args.level == "logic":
+    if args.level == "logic" and sequential:
+        from mechc.sim.sequential import prove_sequential
+
+        report = prove_sequential(design.netlist, spec, seed=args.seed)
+    elif args.level == "logic":
         from mechc.sim.logic import prove_logic
 
         report = prove_logic(design.netlist, spec)
@@ -291,7 +335,7 @@ def cmd_simulate(args) -> int:
         report = prove_kinematic(design, spec, lib, tolerance=args.tolerance, seed=args.seed)
     else:
         from mechc.mech.dynamics import DynSettings
-        from mechc.sim.dynamic import prove_dynamic
+        from mechc.sim.dynamic import PRUNE_DEFAULT, prove_dynamic
         from mechc.ui import Progress
 
         st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
@@ -310,8 +354,19 @@ def cmd_simulate(args) -> int:
             bar.update(done, "input changes")
 
         try:
-            report = prove_dynamic(design, spec, lib, st, tolerance=args.tolerance,
-                                   extra=args.cases, seed=args.seed, progress=tick)
+            if args.accuracy is not None:
+                from mechc.sim.accuracy import prove_with_accuracy
+
+                if any(getattr(args, o) is not None for o in ("dt", "iterations", "move_time")):
+                    raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
+                report = prove_with_accuracy(design, spec, lib, args.accuracy,
+                                             tolerance=args.tolerance, extra=args.cases,
+                                             seed=args.seed, progress=tick,
+                                             prune=args.prune)
+            else:
+                report = prove_dynamic(design, spec, lib, st, tolerance=args.tolerance,
+                                       extra=args.cases, seed=args.seed, progress=tick,
+                                       prune=args.prune or PRUNE_DEFAULT)
         finally:
             bar.close()
     report["design"] = args.design
@@ -339,6 +394,10 @@ SUMMARY_KEYS = [
 def print_report(report: dict, spec) -> None:
     rows = [[label, report[k]] for k, label in SUMMARY_KEYS if report.get(k) is not None]
     print(table(rows, ["level " + report["level"], "value"]))
+    if report.get("accuracy"):
+        from mechc.sim.accuracy import describe
+
+        print(describe(report["accuracy"]))
     verdict = "PASSED" if report["passed"] else "FAILED"
     kinds = report.get("failure_kinds")
     extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
@@ -348,6 +407,12 @@ def print_report(report: dict, spec) -> None:
         print("  " + _failure_text(f))
     if report["failure_count"] > 10:
         print(f"  ... and {report['failure_count'] - 10} more (see --report)")
+    hazards = (report.get("sequential") or {}).get("hazards") or []
+    if hazards:  # timing the logic cannot remove: what the mechanism must respect
+        print(f"ordering requirements ({len(hazards)}; the kinematic and dynamic levels check "
+              "them):")
+        for h in hazards[:10]:
+            print(f"  {h['kind']}: {h['requires']}")
 
 
 def _failure_text(f: dict) -> str:

@@ -51,6 +51,8 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
         from mechc.mech.io import mechanism_json
 
         out["mechanism"] = mechanism_json(mech)
+    if getattr(d, "sequential", None) is not None:
+        out["sequential"] = d.sequential.to_json()
     return out
 
 
@@ -134,7 +136,15 @@ def load_design_json(path: str | Path) -> dict:
 
 
 def design_from_json(obj: dict, where: str = "<json>") -> Design:
-    spec = Spec.from_json(obj["spec"], where)
+    if obj["spec"].get("kind") == "fsm":
+        from mechc.spec.sequential import SeqSpec, SequentialError
+
+        try:
+            spec = SeqSpec.from_json(obj["spec"], where)
+        except (KeyError, ValueError, SequentialError) as e:
+            raise UsageError(f"{where}: inconsistent sequential spec: {e}") from None
+    else:
+        spec = Spec.from_json(obj["spec"], where)
     try:
         nl = Netlist.from_json(obj["inputs"], obj["outputs"], obj["cells"])
     except ValueError as e:

@@ -15,6 +15,9 @@ import numpy as np
 
 from mechc.netlist.types import evaluate_type
 
+#: Logic types whose output is a stored state; a netlist may loop only through these.
+STATEFUL = frozenset({"MEMORY"})
+
 
 @dataclass(frozen=True)
 class CellInst:
@@ -86,13 +89,30 @@ class Netlist:
         self._flush()
 
     def check(self) -> None:
-        """Every net used has a driver; the graph has no cycle (combinational netlist)."""
+        """Every net used has a driver; every cycle passes through a MEMORY's Q (feedback of a
+        sequential circuit); any other cycle is a combinational loop and an error."""
         if self._edges_pending:
             net, node, _pin = self._edges_pending[0]
             raise ValueError(f"net '{net}' used by {node} has no driver")
-        if not nx.is_directed_acyclic_graph(self.graph):
-            cycle = nx.find_cycle(self.graph)
+        comb = self.combinational_graph()
+        if not nx.is_directed_acyclic_graph(comb):
+            cycle = nx.find_cycle(comb)
             raise ValueError(f"combinational loop through {[e[0] for e in cycle]}")
+
+    def state_nets(self) -> dict[str, CellInst]:
+        """Nets driven by a stateful cell (MEMORY Q): the secondary variables, net -> cell."""
+        return {c.outputs[0]: c for c in self.cells.values() if c.type in STATEFUL}
+
+    def combinational_graph(self) -> nx.MultiDiGraph:
+        """The graph with the edges leaving MEMORY cells removed: a stored state is a source
+        for the logic it feeds, so this is acyclic for a well-formed sequential netlist."""
+        cut = [(u, v, k) for u, v, k in self.graph.edges(keys=True)
+               if u in self.cells and self.cells[u].type in STATEFUL]
+        if not cut:
+            return self.graph
+        g = self.graph.copy()
+        g.remove_edges_from(cut)
+        return g
 
     # ---- queries --------------------------------------------------------------------------
     def nets(self) -> dict[str, dict]:
@@ -107,14 +127,18 @@ class Netlist:
         return out
 
     def topo_cells(self) -> list[CellInst]:
-        order = nx.lexicographical_topological_sort(self.graph, key=_sort_key)
+        """Cells in a combinational order (MEMORY outputs count as sources)."""
+        order = nx.lexicographical_topological_sort(self.combinational_graph(), key=_sort_key)
         return [self.cells[n] for n in order if n in self.cells]
 
     def depth(self) -> dict[str, int]:
-        """Logic depth of every cell: 1 + the deepest cell among its drivers (inputs are 0)."""
+        """Logic depth of every cell: 1 + the deepest cell among its drivers (inputs and MEMORY
+        outputs, the state nets, are 0)."""
         d: dict[str, int] = {}
+        state = self.state_nets()
         for cell in self.topo_cells():
-            d[cell.id] = 1 + max((d.get(self.driver[n][0], 0) for n in cell.inputs), default=0)
+            d[cell.id] = 1 + max((0 if n in state else d.get(self.driver[n][0], 0)
+                                  for n in cell.inputs), default=0)
         return d
 
     def count_by_type(self) -> dict[str, int]:

@@ -28,12 +28,15 @@ class MapOptions:
     fan_in: int | None = None  # cap on AND/OR/NAND/NOR inputs (default: the library's limit)
     phase: str = "auto"  # "auto": also try complement and XOR forms; "sop": sum of products only
     hazard_free: bool = True  # build covers with consensus terms (outputs dwell; §3)
+    prefer: tuple[str, ...] = ()  # cells used wherever they fit, even if not auto_select
+    target: str = "conventional"  # "threshold" | "auto": THRESHOLD cells (threshold_map.py)
 
 
 class Planner:
-    def __init__(self, library: Library, fan_in: int | None):
+    def __init__(self, library: Library, fan_in: int | None, prefer: tuple[str, ...] = ()):
         self.lib = library
         self.fan_in = fan_in
+        self.prefer = prefer
 
     # ---- primitive gates --------------------------------------------------------------------
     def limit(self, type_name: str) -> int:
@@ -60,9 +63,15 @@ class Planner:
             return 0
         seen.add(key)
         if key[0] == "CONST":
-            return self.lib.for_type("CONST", 0).cost(0)
-        total = self.lib.for_type(key[0], len(key[1])).cost(len(key[1]))
+            return self.costed("CONST", 0).cost(0)
+        total = self.costed(key[0], len(key[1])).cost(len(key[1]))
         return total + sum(self.cost(k, seen) for k in key[1])
+
+    def costed(self, type_name: str, n: int):
+        """The cell a structure is costed with: the mapper's own choice, so preferred cells
+        (--use-cell) replace cells without changing which structure is built."""
+        return (self.lib.for_type(type_name, n)
+                or self.lib.for_type(type_name, n, self.prefer))
 
     def cheaper(self, a: Key, b: Key) -> Key:
         return a if self.cost(a, set()) <= self.cost(b, set()) else b
@@ -137,7 +146,13 @@ class Mapped:
 
 def map_equations(eq: Equations, library: Library, opts: MapOptions | None = None) -> Mapped:
     opts = opts or MapOptions()
-    pl = Planner(library, opts.fan_in)
+    if opts.target != "conventional":
+        from mechc.netlist.threshold_map import map_threshold
+
+        return map_threshold(eq, library, opts)
+    for name in opts.prefer:  # an unknown name is an error, not silently ignored
+        library[name]
+    pl = Planner(library, opts.fan_in, tuple(opts.prefer))
     built: set = set()
     roots: dict[str, Key] = {}
     for name in eq.outputs:
@@ -162,7 +177,7 @@ def map_equations(eq: Equations, library: Library, opts: MapOptions | None = Non
                 best, best_cost = k, c
         pl.cost(best, built)
         roots[name] = best
-    return Mapped(_materialise(roots, eq, library),
+    return Mapped(_materialise(roots, eq, library, tuple(opts.prefer)),
                   {name: ex.to_text(key_expr(k)) for name, k in roots.items()})
 
 
@@ -210,7 +225,8 @@ def key_expr(key: Key) -> ex.Expr:
     return ex.Not(e) if t in ("NAND", "NOR", "XNOR") else e
 
 
-def _materialise(roots: dict[str, Key], eq: Equations, library: Library) -> Netlist:
+def _materialise(roots: dict[str, Key], eq: Equations, library: Library,
+                 prefer: tuple[str, ...] = ()) -> Netlist:
     nl = Netlist(eq.inputs)
     names: dict[Key, str] = {("in", n): n for n in eq.inputs}
     counter = {"cell": 0, "net": 0}
@@ -230,7 +246,7 @@ def _materialise(roots: dict[str, Key], eq: Equations, library: Library) -> Netl
         else:
             ins = [build(k) for k in key[1]]
             type_name, params = key[0], {}
-        cell_cls = library.for_type(type_name, len(ins))
+        cell_cls = library.for_type(type_name, len(ins), prefer)
         counter["cell"] += 1
         if key in out_net_name:
             net = out_net_name[key]
@@ -254,3 +270,32 @@ def _materialise(roots: dict[str, Key], eq: Equations, library: Library) -> Netl
 
 def cube_key(cube: Cube) -> tuple[int, int]:
     return (cube.mask, cube.value)
+
+
+def map_sequential(eq: Equations, inputs: list[str], memories: list[tuple[str, str, str, int]],
+                   outputs: list[str], library: Library,
+                   opts: MapOptions | None = None) -> Mapped:
+    """SET/RESET/output equations over inputs + memory variables -> one netlist with MEMORY
+    cells. ``memories``: (name, SET function, RESET function, initial) with the functions named
+    among ``eq.outputs``. The combinational mapper builds every function with the memory
+    variables as if they were inputs; each variable then becomes the Q net of a MEMORY cell
+    (inputs [S, R], params.initial) fed by its SET and RESET nets, which closes the feedback."""
+    comb = map_equations(eq, library, opts)
+    src = comb.netlist
+    mem_cls = library.for_type("MEMORY", 2)
+    if mem_cls is None:
+        raise DesignError("the cell library has no MEMORY cell")
+    nl = Netlist(inputs)
+    for c in src.topo_cells():
+        cls = library[c.cell]
+        nl.add_cell(c, pin_names=cls.input_names(len(c.inputs)), out_pins=list(cls.outputs))
+    n_cells = len(src.cells)
+    for j, (name, s_fn, r_fn, initial) in enumerate(memories):
+        cell = CellInst(f"c{n_cells + j + 1}", mem_cls.name, "MEMORY",
+                        (src.outputs[s_fn], src.outputs[r_fn]), (name,),
+                        {"initial": int(initial)})
+        nl.add_cell(cell, pin_names=mem_cls.input_names(2), out_pins=list(mem_cls.outputs))
+    for o in outputs:
+        nl.set_output(o, src.outputs[o])
+    nl.check()
+    return Mapped(nl, dict(comb.implemented))
