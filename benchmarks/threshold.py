@@ -74,6 +74,36 @@ def main() -> None:
     print(f"kinematic proofs (8 rest states + 24 changes x {samples} samples): "
           f"{len(gens) / dt:,.0f} proofs/s over {len(gens)} generators "
           f"({len(gens) * (8 + 24 * samples) / dt:,.0f} evaluations/s)")
+    cells(xc, samples)
+
+
+def cells(xc: np.ndarray, samples: int) -> None:
+    """The THRESHOLD cell (stdlib/threshold.py): every generator built as a mechanism (bodies,
+    joints, cam profile) and proven through the generic closed forms plus the cam follower;
+    the reference is the generator's own closed form on the same states, timed above."""
+    from mechc.mech.build import Demand, SynthContext
+    from mechc.mech.evaluate import signal_of
+    from mechc.netlist.threshold_map import params_of
+    from mechc.threshold.weights import realise
+    from stdlib.threshold import ThresholdCell
+
+    ctx = SynthContext()
+    fvs = [fv for fv in range(256) if design_generator(fv, strict=False).kind == "generator"]
+    t0 = time.perf_counter()
+    parts = [ThresholdCell.synthesise("c1", ctx, 3, params_of(realise(fv)), Demand(0.5, 0.5))
+             for fv in fvs]
+    synth = time.perf_counter() - t0
+    x = np.concatenate([input_matrix(3).T.astype(float), xc], 1)
+    t0 = time.perf_counter()
+    for p in parts:
+        fixed = {p.terminals[k].body: (x[i] - 0.5) * ctx.stroke for i, k in enumerate("ABC")}
+        poses = ThresholdCell.kinematics(p, fixed, x.shape[1])
+        t = p.terminals["Z"]
+        signal_of(t, p.body(t.body), poses)
+    dt = time.perf_counter() - t0
+    print(f"threshold cells synthesised (all {len(fvs)} generator functions): {synth:.2f} s")
+    print(f"threshold cell kinematic proofs per second: {len(parts) / dt:.1f} "
+          f"({len(parts) * x.shape[1] / dt:,.0f} cell states/s, 24 changes x {samples} samples)")
 
 
 if __name__ == "__main__":

@@ -27,9 +27,11 @@ from mechc.pipeline import Design
 from mechc.sim.cases import gray_tour, random_walk
 from mechc.sim.kinematic import sweep
 from mechc.sim.logic import check_interface
+from mechc.sim.prune import blocker, run_case
 from mechc.spec.model import Spec
 
 MAX_LISTED = 50
+PRUNE_DEFAULT = False  # per-change pruned scenes (mechc.sim.prune); see docs/performance.md
 
 
 def plan(n: int, extra: int, seed: int) -> list[int]:
@@ -44,7 +46,13 @@ def plan(n: int, extra: int, seed: int) -> list[int]:
 def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSettings | None = None,
                   tolerance: float = 0.05, extra: int = 16, seed: int = 0,
                   progress: Callable[[int, int], None] | None = None,
-                  cells: list[str] | None = None) -> dict:
+                  cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
+                  max_cases: int | None = None, record: list | None = None) -> dict:
+    """``prune``: each change runs on its own scene holding only what can move the outputs
+    (``mechc.sim.prune``; every change then starts from the closed-form rest pose); else one
+    scene of the whole mechanism (or of ``cells``) runs the whole tour. ``max_cases`` keeps
+    the first changes of the plan only; ``record`` (a list) receives each change's inputs and
+    final output positions (for step-halving checks)."""
     t0 = time.perf_counter()
     st = settings or DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
                                  if design.mechanism else 0.1)
@@ -55,8 +63,18 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     names = list(spec.inputs)
     n = len(names)
     types = {c.id: c.cell for c in design.netlist.cells.values()}
-    scene = Scene.build(mech, lib, types, st, {k: 0.0 for k in names}, cells)
+    why_not = None if prune and cells is None else "not requested"
+    if why_not is None:
+        why_not = blocker(design.netlist, lib)
+    prune = why_not is None
+    scene = None if prune else Scene.build(mech, lib, types, st, {k: 0.0 for k in names}, cells)
+    state = {k: 0.0 for k in names}
+    sizes: list[tuple[int, int, int]] = []  # pruned scenes: (cells, dynamic bodies, constraints)
+    escalated = 0
+    max_watch = 0.0
     vectors = plan(n, extra, seed)
+    if max_cases is not None:
+        vectors = vectors[:max_cases]
     cols = np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in [0, *vectors]],
                     dtype=bool).T
     wants = spec.values_at(cols)  # spec value before (column i) and after (i + 1) each change
@@ -72,9 +90,19 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         k = n - 1 - diff.bit_length() + 1
         name = names[k]
         target = (vec >> (n - 1 - k)) & 1
-        r = scene.move(name, float(target))
+        if prune:
+            run = run_case(design.netlist, mech, lib, types, st, state, name, float(target))
+            r = run.result
+            sizes.append((run.cells, run.bodies, run.constraints))
+            escalated += run.escalated
+            max_watch = max(max_watch, run.watch_deviation)
+        else:
+            r = scene.move(name, float(target))
+        state[name] = float(target)
         steps += r.steps
         case = {"inputs": _vec(vec, names), "moving": name, "to": int(target)}
+        if record is not None:
+            record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation})
 
         def fail(kind, case=case, **info):
             counts[kind] += 1
@@ -149,11 +177,32 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         "max_settle_time_s": round(max_settle, 5),
         "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
         "steps": steps,
-        "scene": {"bodies": len(scene.bodies), "joints": len(scene.joints),
-                  "constraints": len(scene.space.constraints), "cells": len(scene.cells)},
+        "scene": _scene_json(scene, sizes),
+        "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order)),
         "settings": st.to_json(),
         "seconds": round(time.perf_counter() - t0, 4),
     }
+
+
+def _scene_json(scene: Scene | None, sizes: list[tuple[int, int, int]]) -> dict:
+    """The whole scene's size, or the largest pruned scene's."""
+    if scene is not None:
+        return {"bodies": len(scene.bodies), "joints": len(scene.joints),
+                "constraints": len(scene.space.constraints), "cells": len(scene.cells)}
+    big = max(sizes, key=lambda x: x[2], default=(0, 0, 0))
+    return {"bodies": big[1], "constraints": big[2], "cells": big[0], "largest_of": len(sizes)}
+
+
+def _pruning_json(why_not: str | None, sizes: list[tuple[int, int, int]], escalated: int,
+                  max_watch: float, cells: int) -> dict:
+    if why_not is not None:
+        return {"enabled": False, "reason": why_not}
+    a = np.array(sizes, dtype=float).reshape(-1, 3)
+    return {"enabled": True, "circuit_cells": cells,
+            "mean_cells": round(float(a[:, 0].mean()), 3) if len(a) else 0.0,
+            "mean_dynamic_bodies": round(float(a[:, 1].mean()), 3) if len(a) else 0.0,
+            "mean_constraints": round(float(a[:, 2].mean()), 3) if len(a) else 0.0,
+            "escalated_cases": escalated, "max_watch_deviation_fraction": round(max_watch, 6)}
 
 
 def _vec(row: int, names: list[str]) -> dict[str, int]:

@@ -191,7 +191,8 @@ def synthesise_loop(sp: SamplePoints, gaps: tuple[int, ...], mu_min: float = 45.
                        options={"xatol": 1e-6, "fatol": 1e-5, "maxiter": 200})
     if res.fun < 1e5:
         x = res.x
-    return make_loop(x[0:2], x[2], x[3], branch, sp)
+    # the penalty lets Nelder-Mead end a hair (< 1e-6 l) short of the l/3 limit: clamp
+    return make_loop(x[0:2], max(x[2], MIN_LINK), max(x[3], MIN_LINK), branch, sp)
 
 
 def make_loop(K, fj: float, jk: float, branch: int, sp: SamplePoints) -> ThresholdLoop:

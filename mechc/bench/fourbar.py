@@ -1,0 +1,123 @@
+"""One crank-rocker four-bar, solved by mechc's kinematic level and by pylinkage, for the peer
+comparison of the speed benchmark.
+
+mechc's path is the one every mechanism's kinematic proof takes: a :class:`Part` of two levers
+(crank and rocker, on ground pivots) joined by a rod (the coupler), solved by
+``mechc.mech.kinematics.solve`` with the crank's angle given — the rocker then comes from the
+rod's circle meeting the rocker's circle (``_lever_from_rod``), vectorised over all crank
+angles at once, with transmission angles, toggle margins and the loop-closure check computed on
+the way, as in a proof. pylinkage (an optional benchmark dependency, never imported by mechc
+itself) steps its Crank + RRRDyad linkage one position after another.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechc.mech.kinematics import solve
+from mechc.mech.model import Body, Joint, Part
+
+GROUND_LEN, CRANK, COUPLER, ROCKER = 40.0, 10.0, 40.0, 30.0  # mm: Grashof crank-rocker
+
+
+def _circle_meet(a, b, ra, rb, upper=True):
+    d = math.dist(a, b)
+    along = (ra * ra - rb * rb + d * d) / (2 * d)
+    h = math.sqrt(ra * ra - along * along)
+    ex, ey = (b[0] - a[0]) / d, (b[1] - a[1]) / d
+    s = 1.0 if upper else -1.0
+    return (a[0] + along * ex - s * h * ey, a[1] + along * ey + s * h * ex)
+
+
+def mechc_part() -> tuple[Part, tuple[float, float]]:
+    """The four-bar at its design pose (crank at +90°), and the rocker pin there."""
+    o2 = (GROUND_LEN, 0.0)
+    a = (0.0, CRANK)
+    b = _circle_meet(o2, a, ROCKER, COUPLER, upper=True)
+    if b[1] < 0:
+        b = _circle_meet(o2, a, ROCKER, COUPLER, upper=False)
+    crank = Body("crank", "lever", [[(0.0, 0.0), a, (1.0, CRANK)]], 0.01, pivot=(0.0, 0.0))
+    rocker = Body("rocker", "lever", [[o2, b, (o2[0] + 1.0, 0.0)]], 0.01, pivot=o2)
+    j = Joint("coupler", "rod", "crank", "rocker", pa=a, pb=b, length=COUPLER)
+    return Part([crank, rocker], [j]), b
+
+
+def mechc_rocker_pins(crank_angles: np.ndarray) -> np.ndarray:
+    """(N, 2) rocker pin positions for absolute crank angles (rad), by mechc's closed form."""
+    part, b = mechc_part()
+    poses = solve(part, {"crank": np.asarray(crank_angles) - math.pi / 2}, len(crank_angles))
+    th = poses.theta["rocker"]
+    rx, ry = b[0] - GROUND_LEN, b[1]
+    return np.stack([GROUND_LEN + rx * np.cos(th) - ry * np.sin(th),
+                     rx * np.sin(th) + ry * np.cos(th)], axis=1)
+
+
+def pylinkage_linkage(steps_per_turn: int):
+    from pylinkage.actuators import Crank
+    from pylinkage.components import Ground
+    from pylinkage.dyads import RRRDyad
+    from pylinkage.simulation import Linkage
+
+    o1 = Ground(0.0, 0.0, name="O1")
+    o2 = Ground(GROUND_LEN, 0.0, name="O2")
+    crank = Crank(anchor=o1, radius=CRANK, angular_velocity=2 * math.pi / steps_per_turn)
+    rocker = RRRDyad(crank.output, o2, distance1=COUPLER, distance2=ROCKER)
+    return Linkage([o1, o2, crank, rocker], name="four-bar")
+
+
+@dataclass
+class PeerResult:
+    mechc_per_s: float
+    pylinkage_step_per_s: float  # Linkage.step, its Python API
+    pylinkage_fast_per_s: float | None  # Linkage.step_fast (numba-compiled if numba is there)
+    pylinkage_backend: str
+    max_difference_mm: float  # rocker pin, mechc against pylinkage, same crank angles
+    positions: int
+
+
+CHUNK = 4096  # states per vectorised call: cache-sized, as a proof's sweep would chunk them
+
+
+def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResult:
+    """Positions (rocker pin coordinates) per second of both on the same four-bar, CPU time,
+    best of ``repeat``; and how far apart their rocker pins are."""
+    import pylinkage._numba_compat as nc
+
+    th = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    mechc_rocker_pins(th[:1000])  # warm
+    best = math.inf
+    for _ in range(repeat):
+        t0 = time.process_time()
+        for s in range(0, n, CHUNK):
+            mechc_rocker_pins(th[s:s + CHUNK])
+        best = min(best, time.process_time() - t0)
+    mechc_rate = n / best
+    # pylinkage, Python API
+    lk = pylinkage_linkage(n_step)
+    t0 = time.process_time()
+    traj = [p[3] for p in lk.step(iterations=n_step)]
+    step_rate = n_step / (time.process_time() - t0)
+    # the same crank angles (pylinkage starts at angle 0 and yields after each increment)
+    angles = 2 * math.pi / n_step * np.arange(1, n_step + 1)
+    diff = float(np.max(np.abs(np.array(traj) - mechc_rocker_pins(angles))))
+    # pylinkage, compiled path
+    fast_rate = None
+    try:
+        lk2 = pylinkage_linkage(n)
+        lk2.step_fast(iterations=100)  # compile
+        best = math.inf
+        for _ in range(repeat):
+            t0 = time.process_time()
+            tr = lk2.step_fast(iterations=n)
+            best = min(best, time.process_time() - t0)
+        fast_rate = n / best
+        if not np.isfinite(tr).all():
+            fast_rate = None
+    except Exception:  # an optional path of an optional peer: report it missing
+        fast_rate = None
+    return PeerResult(mechc_rate, step_rate, fast_rate,
+                      "numba" if nc.HAS_NUMBA else "python", diff, n)
