@@ -275,6 +275,10 @@ def cmd_compile(args) -> int:
         for m in se.memories:
             print(f"  MEMORY {m}: set = {se.text(se.set_names[m])}, reset = "
                   f"{se.text(se.reset_names[m])}, initial {se.initial[m]}")
+        if se.checked.get("sr_overlap_total_states"):
+            print(f"  note: SET and RESET of a memory are both on in "
+                  f"{se.checked['sr_overlap_total_states']} total state(s) that the spec never "
+                  "reaches (every reachable one was checked)")
         for h in se.essential_hazards:
             print(f"  essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
                   f"{h['to']}: {h['requires']}")
@@ -317,9 +321,9 @@ def cmd_simulate(args) -> int:
     design = load_design_or_spec(args.design, args)
     spec = _load_spec(args.spec) if args.spec else design.spec
     sequential = getattr(spec, "kind", "") == "fsm"
-    if sequential != any(c.type == "MEMORY" for c in design.netlist.cells.values()):
-        raise UsageError("a sequential design (with MEMORY cells) is proved against a .fsm spec "
-                         "and a combinational one against a .bool/.pla spec")
+    if not sequential and any(c.type == "MEMORY" for c in design.netlist.cells.values()):
+        raise UsageError("a sequential design (with MEMORY cells) is proved against a .fsm spec, "
+                         "not a combinational one")
     lib = load_library(args.cell_dirs)
     if args.level == "logic" and sequential:
         from mechc.sim.sequential import prove_sequential
