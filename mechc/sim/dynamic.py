@@ -8,6 +8,9 @@ move leaves that margin on the way (a glitch); the scene does not settle in time
 actuator cannot bring its slider to the target (stall); a bilateral joint stretches beyond its
 limit or a contact is overrun beyond its limit ("solver error" — pymunk stretches joints
 silently when overdriven or stepped too coarsely, so this is never passed).
+
+With ``prune`` each change runs on a scene of only the cells that can move the outputs
+(``mechc.sim.prune``); off by default, see docs/performance.md for why.
 """
 
 from __future__ import annotations
