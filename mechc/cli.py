@@ -333,6 +333,26 @@ def cmd_simulate(args) -> int:
         from mechc.sim.logic import prove_logic
 
         report = prove_logic(design.netlist, spec)
+    elif args.level == "kinematic" and sequential:
+        from mechc.sim.seqmech import prove_sequential_kinematic
+
+        report = prove_sequential_kinematic(design, spec, lib, tolerance=args.tolerance,
+                                            seed=args.seed)
+    elif args.level == "dynamic" and sequential:
+        from mechc.sim.seqmech import prove_sequential_dynamic
+        from mechc.ui import Progress
+
+        bar = Progress(1, f"sequential dynamic proof of {Path(args.design).name}")
+
+        def step(done, total):
+            bar.total = total
+            bar.update(done, "input changes")
+
+        try:
+            report = prove_sequential_dynamic(design, spec, lib, tolerance=args.tolerance,
+                                              seed=args.seed, progress=step)
+        finally:
+            bar.close()
     elif args.level == "kinematic":
         from mechc.sim.kinematic import prove_kinematic
 

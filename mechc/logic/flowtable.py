@@ -47,7 +47,7 @@ from mechc.spec.sequential import (
 )
 
 #: Enumerate every compatible (for prime compatibles) up to this many; beyond, maximal only.
-MAX_COMPATIBLES = 20_000
+MAX_COMPATIBLES = 5_000
 #: Exact minimum-variable assignment (all bipartitions of the merged rows) up to this many rows;
 #: beyond, a set cover over bipartitions grown from the dichotomies (not proven minimal).
 EXACT_ASSIGN_MAX_ROWS = 10
@@ -156,18 +156,17 @@ def prime_compatibles(ft: FlowTable, comps: list[frozenset[int]]) -> list[frozen
     """Compatibles not excluded by a larger one whose class set is no harder to close
     (Grasselli–Luccio): some minimum closed cover uses prime compatibles only."""
     cs = {c: class_set(ft, c) for c in comps}
-    by_size = sorted(comps, key=len, reverse=True)
+    as_int = np.array([sum(1 << r for r in c) for c in comps], dtype=np.uint64) \
+        if len(ft.rows) <= 64 else None
     primes = []
-    for c in by_size:
+    for i, c in enumerate(comps):
         pc = cs[c]
-        excluded = False
-        for d in by_size:
-            if len(d) <= len(c):
-                break
-            if c < d and all(any(kd <= kc for kc in pc) for kd in cs[d]):
-                excluded = True
-                break
-        if not excluded:
+        if as_int is not None:  # the strict supersets of c, vectorised
+            cm = as_int[i]
+            sup = np.flatnonzero(((as_int & cm) == cm) & (as_int != cm))
+        else:
+            sup = [j for j, d in enumerate(comps) if c < d]
+        if not any(all(any(kd <= kc for kc in pc) for kd in cs[comps[j]]) for j in sup):
             primes.append(c)
     return primes
 

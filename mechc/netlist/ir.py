@@ -150,6 +150,9 @@ class Netlist:
     # ---- logic evaluation -----------------------------------------------------------------
     def evaluate(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Every net's value for the input vectors in ``values`` (by logic type)."""
+        if self.state_nets():
+            raise TypeError("this netlist has MEMORY cells, which are stateful: evaluate it "
+                            "with mechc.sim.sequential, not combinationally")
         size = len(next(iter(values.values()))) if values else 1
         nets = dict(values)
         for cell in self.topo_cells():

@@ -116,8 +116,9 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
             state = path_state
             cur = {n: float(v) for n, v in seq[k].items()}
             steps += 1
-    return {"passed": fails.total == 0, "level": "kinematic", "sequential": True,
-            "steps": steps, "memories": len(mems), "tolerance_fraction": tolerance,
+    return {"passed": fails.total == 0, "level": "kinematic",
+            "steps": steps, "cases": steps, "memories": len(mems),
+            "tolerance_fraction": tolerance,
             "failure_count": fails.total, "failure_kinds": fails.counts,
             "failures": fails.items, "max_deviation_fraction": round(dev[0], 6),
             "min_margin_fraction": round(0.5 - dev[0], 6),
@@ -177,7 +178,7 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
             done += 1
             if progress:
                 progress(done, total)
-    return {"passed": fails.total == 0, "level": "dynamic", "sequential": True,
+    return {"passed": fails.total == 0, "level": "dynamic",
             "cases": done, "sequences": len(walks), "seed": seed,
             "tolerance_fraction": tolerance, "failure_count": fails.total,
             "failure_kinds": fails.counts, "failures": fails.items,

@@ -394,6 +394,8 @@ def transition_tour(spec: SeqSpec, seed: int = 0, random_walks: int = 0,
         if len(seq) == 1:
             break  # nothing reachable is left (cannot happen: every node is reachable)
         seqs.append(seq)
+    if not seqs:  # nothing to change from power-up: the power-up state alone
+        seqs.append([x0])
     rng = np.random.default_rng(seed)
     steps = length if length is not None else max(8, 2 * g.transitions)
     for _ in range(random_walks):
