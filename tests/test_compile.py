@@ -194,7 +194,10 @@ def test_timings_only_on_request(cli, tmp_path):
     cli("compile", EXAMPLES / "sorter.bool", "-o", out, "--timings")
     secs = json.loads(out.read_text())["stats"]["seconds"]
     assert set(secs) == {"minimise", "map", "place", "synthesise", "check"}
-    assert all(v >= 0 for v in secs.values())
+    assert secs["minimise"] > 0 and secs["check"] > 0  # measured, not placeholders
+    plain = tmp_path / "p.json"
+    cli("compile", EXAMPLES / "sorter.bool", "-o", plain)
+    assert "seconds" not in json.loads(plain.read_text())["stats"]  # reproducible by default
 
 
 def test_layout_columns_follow_logic_depth(cli, tmp_path):
