@@ -18,7 +18,7 @@ from mechc.errors import (
     SpecError,
     UsageError,
 )
-from mechc.ui import table
+from mechc.ui import int_at_least, table
 
 DESCRIPTION = """\
 mechc compiles logic into mechanisms: a Boolean or sequential specification becomes a netlist of
@@ -158,7 +158,7 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
     g.add_argument("--use-cell", dest="use_cell", action="append", default=[], metavar="NAME",
                    help="use library cell NAME wherever it fits, also one the mapper does not "
                    "choose by itself (e.g. three_bar_and; repeatable)")
-    g.add_argument("--fan-in", type=_positive_int(2), default=None, metavar="N",
+    g.add_argument("--fan-in", type=int_at_least(2), default=None, metavar="N",
                    help="at most N inputs per AND/OR/NAND/NOR cell (default: the library's)")
     g.add_argument("--time-limit", type=float, default=20.0, metavar="S",
                    help="seconds per exact-cover program before the best cover found is used "
@@ -182,19 +182,6 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
                    help="rated force of each input actuator (default: %(default)s N)")
     m.add_argument("--output-load", type=float, default=0.5, metavar="N",
                    help="force each circuit output must move either way (default: %(default)s N)")
-
-
-def _positive_int(lo: int):
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
-        if v < lo:
-            raise argparse.ArgumentTypeError(f"must be at least {lo}")
-        return v
-
-    return parse
 
 
 def _options(args):

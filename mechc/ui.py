@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from collections.abc import Sequence
@@ -71,3 +72,17 @@ def _fmt(v: object) -> str:
     if isinstance(v, float):
         return f"{v:.4g}"
     return str(v)
+
+
+def int_at_least(lo: int):
+    """An argparse type: a whole number no smaller than ``lo`` (a clear message otherwise)."""
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
+        if v < lo:
+            raise argparse.ArgumentTypeError(f"must be at least {lo}")
+        return v
+
+    return parse

@@ -1,27 +1,10 @@
 """AND: an output bar sprung towards on, held back by every input that is off (001 Figs 5, 16b)."""
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder
+from stdlib._bar_cells import BarGate
 
 
-class AndGate(Cell):
+class AndGate(BarGate):
     name = "and"
     type = "AND"
-    min_inputs = 2
-    max_inputs = 4
+    bar_kind = "and"
     description = "output bar sprung towards on, held off by any input that is off (Figs 5, 16b)"
-
-    @classmethod
-    def cost(cls, n_inputs: int) -> int:
-        return 2 + n_inputs
-
-    @classmethod
-    def synthesise(cls, cid, ctx, n_inputs, params, demand):
-        b = Builder(cid, ctx)
-        S, w, p = ctx.stroke, ctx.bar, ctx.pitch
-        pins = cls.input_names(n_inputs)
-        sigs = [b.input_slider(pin, 0.0, -i * p, 1.5 * S) for i, pin in enumerate(pins)]
-        bar, loads = b.and_bar("bar", sigs, 1.5 * S + w / 2, demand)
-        bar.y = -(n_inputs - 1) * p / 2 - p / 2
-        b.output(bar, "Z", reach=bar.x + 0.8 * S)
-        return b.finish(dict(zip(pins, loads)))

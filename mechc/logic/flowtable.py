@@ -35,7 +35,7 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 
 from mechc.errors import DesignError
 from mechc.logic.cubes import DC, Cube, eval_cover
-from mechc.logic.minimise import Equations, MinimiseOptions, minimise
+from mechc.logic.minimise import Equations, MinimiseOptions, count_shared, minimise
 from mechc.spec import expr as ex
 from mechc.spec.model import OutputSpec, Spec
 from mechc.spec.sequential import (
@@ -850,17 +850,8 @@ def _merge(names, sr_eqs: list[Equations], eq_z: Equations, set_names, reset_nam
     eq.complements.update(eq_z.complements)
     eq.hazard_free_complements.update(eq_z.hazard_free_complements)
     eq.covers = {o: eq.covers[o] for o in order}
-    eq.shared_terms = _count_shared(eq)
+    eq.shared_terms = count_shared(eq)
     return eq
-
-
-def _count_shared(eq: Equations) -> int:
-    counts: dict[Cube, int] = {}
-    for cover in eq.covers.values():
-        for c in set(cover.cubes):
-            if c.literals() >= 2:
-                counts[c] = counts.get(c, 0) + 1
-    return sum(1 for v in counts.values() if v > 1)
 
 
 def _double_changes(rt: ReducedTable, asg: Assignment, exc: Excitation,

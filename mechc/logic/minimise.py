@@ -131,7 +131,7 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
                 eq.xor_forms[name] = xf
     if opts.share and len(spec.outputs) > 1:
         _share(spec, eq, prime_sets, opts)
-    eq.shared_terms = _count_shared(eq)
+    eq.shared_terms = count_shared(eq)
     if opts.hazard_free:
         for name in spec.outputs:
             table = spec.table(name)
@@ -307,7 +307,7 @@ def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None
         eq.covers[nm] = Cover(new[nm], old.proven, old.method, old.seconds)
 
 
-def _count_shared(eq: Equations) -> int:
+def count_shared(eq: Equations) -> int:
     """Product terms (with at least two literals) used by more than one output."""
     counts: dict[Cube, int] = {}
     for cover in eq.covers.values():
@@ -335,7 +335,7 @@ def _minimise_wide(spec: Spec, opts: MinimiseOptions) -> Equations:
         res = espresso(spec.n, f.on, f.dc, f.off, f.rest, time_limit=opts.time_limit)
         covers[name] = Cover(res.cubes, False, "espresso", res.seconds)
     eq = Equations(list(spec.inputs), list(spec.outputs), covers)
-    eq.shared_terms = _count_shared(eq)
+    eq.shared_terms = count_shared(eq)
     verify_wide(spec, eq)
     return eq
 

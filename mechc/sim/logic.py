@@ -51,23 +51,8 @@ def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> dict:
     m = input_matrix(n)
     env = {name: m[k] for k, name in enumerate(spec.inputs)}
     nets = nl.evaluate(env)
-    failures = []
-    total_bad = 0
-    care_cases = 0
-    for o in spec.outputs:
-        want = spec.table(o)
-        got = nets[nl.outputs[o]]
-        care = want != DC
-        care_cases += int(care.sum())
-        bad = np.flatnonzero(care & (got != (want == 1)))
-        total_bad += len(bad)
-        for row in bad[:MAX_LISTED_FAILURES - len(failures)]:
-            failures.append({
-                "output": o,
-                "inputs": {name: int(m[k, row]) for k, name in enumerate(spec.inputs)},
-                "expected": int(want[row]),
-                "got": int(got[row]),
-            })
+    wants = {o: spec.table(o) for o in spec.outputs}
+    failures, total_bad, care_cases = _compare(nl, spec, nets, wants, env)
     return {
         "passed": total_bad == 0,
         "level": "logic",
@@ -81,6 +66,28 @@ def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> dict:
         "max_joint_violation_mm": None, "min_transmission_angle_deg": None,
         "seconds": round(time.perf_counter() - t0, 6),
     }
+
+
+def _compare(nl: Netlist, spec: Spec, nets: dict, wants: dict[str, np.ndarray],
+             inputs: dict[str, np.ndarray]) -> tuple[list[dict], int, int]:
+    """Netlist outputs against the spec's values on every care row: (listed failures, failure
+    count, care rows checked)."""
+    failures: list[dict] = []
+    total_bad = care_cases = 0
+    for o in spec.outputs:
+        want, got = wants[o], nets[nl.outputs[o]]
+        care = want != DC
+        care_cases += int(care.sum())
+        bad = np.flatnonzero(care & (got != (want == 1)))
+        total_bad += len(bad)
+        for row in bad[:MAX_LISTED_FAILURES - len(failures)]:
+            failures.append({
+                "output": o,
+                "inputs": {name: int(inputs[name][row]) for name in spec.inputs},
+                "expected": int(want[row]),
+                "got": int(got[row]),
+            })
+    return failures, total_bad, care_cases
 
 
 def _check_sampled(nl: Netlist, spec: Spec, t0: float, seed: int) -> dict:
@@ -106,26 +113,15 @@ def _check_sampled(nl: Netlist, spec: Spec, t0: float, seed: int) -> dict:
     X = _words(vectors, n)
     values = {name: _position(X, n - 1 - k) for k, name in enumerate(spec.inputs)}
     nets = nl.evaluate(values)
-    failures = []
-    total_bad = care_cases = 0
+    wants = {}
     for o in spec.outputs:
         f = spec.functions[o]
         want = np.full(len(vectors), f.rest, dtype=np.int8)
         want[_member(X, f.off, n)] = 0
         want[_member(X, f.on, n)] = 1
         want[_member(X, f.dc, n)] = DC
-        got = nets[nl.outputs[o]]
-        care = want != DC
-        care_cases += int(care.sum())
-        bad = np.flatnonzero(care & (got != (want == 1)))
-        total_bad += len(bad)
-        for row in bad[:MAX_LISTED_FAILURES - len(failures)]:
-            failures.append({
-                "output": o,
-                "inputs": {name: int(values[name][row]) for name in spec.inputs},
-                "expected": int(want[row]),
-                "got": int(got[row]),
-            })
+        wants[o] = want
+    failures, total_bad, care_cases = _compare(nl, spec, nets, wants, values)
     return {
         "passed": total_bad == 0,
         "level": "logic",

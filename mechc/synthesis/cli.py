@@ -14,6 +14,7 @@ import textwrap
 import numpy as np
 
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mechc.ui import int_at_least
 
 SYNTH_DESCRIPTION = """\
 Dimensional synthesis: find link lengths and pivots.
@@ -101,7 +102,7 @@ def register(sub) -> None:
                        + ", ".join(_example_names(kind)))
         d.add_argument("--free", action="append", default=[], metavar="NAMEj=DEG",
                        help="set a free choice, e.g. beta2=-110 (repeatable)")
-        d.add_argument("--grid", type=_int_at_least(36), default=1440, metavar="N",
+        d.add_argument("--grid", type=int_at_least(36), default=1440, metavar="N",
                        help="samples per searched angle (default: %(default)s)")
         if kind == "dyad":
             d.add_argument("--defects", action="store_true",
@@ -129,7 +130,7 @@ def register(sub) -> None:
                    help="travel of input 1")
     a.add_argument("--range2", type=_range, required=True, metavar="LO:HI",
                    help="travel of input 2")
-    a.add_argument("--samples", type=_int_at_least(2), default=41, metavar="N",
+    a.add_argument("--samples", type=int_at_least(2), default=41, metavar="N",
                    help="samples per input (default: %(default)s)")
     _common(a)
     a.set_defaults(func=cmd_adder)
@@ -176,19 +177,6 @@ def _fraction(text: str) -> float:
     if not 0 <= v <= 1:
         raise argparse.ArgumentTypeError(f"expected a ratio in [0, 1], got {text}")
     return v
-
-
-def _int_at_least(lo: int):
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
-        if v < lo:
-            raise argparse.ArgumentTypeError(f"must be at least {lo}")
-        return v
-
-    return parse
 
 
 def _pair(text: str) -> tuple[float, float]:
