@@ -171,8 +171,7 @@ def run_design_checks(design: Design, lib: Library) -> None:
     budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
     sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
     measured = stats.checks()
-    kept = ("actuator force", "force budget converged")  # measured at synthesis, not here
-    mech.checks = [c for c in mech.checks if c.name in kept] + measured
+    mech.checks = mech.synthesis_checks() + measured
     failed = [c for c in mech.checks if not c.passed]
     mus = [c.value for c in mech.checks if c.name == "transmission angle"]
     design.stats["design_checks"] = {

@@ -40,6 +40,10 @@ class Mechanism:
     order: list[str]  # cells in topological order
     checks: list[Check] = field(default_factory=list)
 
+    def synthesis_checks(self) -> list[Check]:
+        """The checks decided when the mechanism was sized (forces), not by a kinematic sweep."""
+        return [c for c in self.checks if c.name in SYNTHESIS_CHECKS]
+
     def owner_part(self, owner: str) -> Part:
         return self.inputs[owner[3:]] if owner.startswith("in:") else self.cells[owner]
 
@@ -50,6 +54,9 @@ class Mechanism:
 
     def body_index(self) -> dict:
         return {b.id: b for p in self.all_parts() for b in p.bodies}
+
+
+SYNTHESIS_CHECKS = ("actuator force", "force budget converged")
 
 
 def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,

@@ -151,7 +151,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
             progress(i + 1, len(vectors))
     stats = CheckStats(mech)
     sweep(design, lib, samples=5, stats=stats)
-    kin_checks = stats.checks() + [c for c in mech.checks if c.name == "actuator force"]
+    kin_checks = stats.checks() + mech.synthesis_checks()
     mus = [c.value for c in kin_checks if c.name == "transmission angle"]
     bad_checks = [c for c in kin_checks if not c.passed]
     for c in bad_checks:

@@ -147,7 +147,7 @@ def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float =
             failures.append({"kind": "dwell", "output": o,
                              "inputs": _vec(edge_bits[:, i], names), "moving": names[e_k[i]],
                              "expected": int(lo[i]), "max_deviation_fraction": _num(d[i])})
-    checks = stats.checks() + [c for c in mech.checks if c.name == "actuator force"]
+    checks = stats.checks() + mech.synthesis_checks()
     for c in checks:
         if not c.passed:
             fail_count += 1

@@ -52,6 +52,14 @@ class _Failures:
         return sum(self.counts.values())
 
 
+def _synthesis_failures(fails: _Failures, design: Design) -> None:
+    """Force checks decided at synthesis fail the proof too (a design that needs amplifiers)."""
+    for c in design.mechanism.synthesis_checks():
+        if not c.passed:
+            fails.add("design check", check=c.name, where=c.where, value=round(c.value, 6),
+                      limit=c.limit, message=c.text())
+
+
 def _walks(spec, seed: int, random_walks: int):
     seqs = transition_tour(spec, seed=seed, random_walks=random_walks)
     return [(s, expected_after(spec, s)) for s in seqs]
@@ -83,6 +91,7 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
     mech, types = design.mechanism, _types(design)
     mems = stateful_cells(design, lib)
     fails = _Failures()
+    _synthesis_failures(fails, design)
     dev = [0.0]
     steps = 0
     t = np.linspace(0.0, 1.0, samples)
@@ -141,6 +150,7 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
     walks = _walks(spec, seed, random_walks)
     total = sum(len(s) - 1 for s, _ in walks)
     fails = _Failures()
+    _synthesis_failures(fails, design)
     dev = [0.0]
     max_vio = max_pen = max_err = max_settle = 0.0
     worst = ""
