@@ -119,7 +119,6 @@ class Scene:
         sc.state = dict(start)
         index = mech.body_index()
         sc._index = index
-        keep = set(sc.cells)
         parts = [mech.inputs[n] for n in mech.inputs] + [mech.cells[c] for c in sc.cells]
         own = {b.id for p in parts for b in p.bodies}
         # bodies outside the scene that its rods hang on become closed-form driven
@@ -142,7 +141,6 @@ class Scene:
             lib[types[cid]].build_dynamics(sc, p)  # what the geometry alone cannot say
         for j in rods:
             sc._add_joint(j)
-        del keep
         for name, part in mech.inputs.items():
             t = part.terminals[name]
             body = sc.bodies[t.body]
