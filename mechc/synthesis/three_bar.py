@@ -131,6 +131,11 @@ def solve_closed_form(sep: float, stroke: float, output: float) -> list[ThreeBar
     lhs, rhs = k * h * (2 * x - s), x * (2 * m - s)
     if abs(lhs - rhs) > 1e-9 * max(abs(lhs), abs(rhs), s * s):
         return []  # a root of the squared equation only
+    r = _gate_residual(sep, stroke, m, x)
+    if not abs(r) <= 1e-9 * max(s, sep, abs(x)):
+        # O is equidistant from M and M' but on the other side of M' in FT: the output link
+        # would have to pass upright (a toggle) on the way, so not a gate on this branch
+        return []
     return [_design(sep, stroke, m, x)]
 
 
@@ -141,16 +146,35 @@ def toggle_design(sep: float, stroke: float, output: float) -> ThreeBarDesign:
     return _design(sep, stroke, m, output)
 
 
+def _gate_residuals(sep, stroke, m, xo) -> np.ndarray:
+    """Output in FT minus output in FF for many m at once, by forward kinematics (the circle
+    intersections of :func:`kinematics`, not the closed form); NaN where either state cannot be
+    assembled clear of a toggle."""
+    m = np.asarray(m, float)
+    s = stroke
+    di, do = np.hypot(m, sep), np.abs(xo - m)
+    side = np.where(xo >= m, 1.0, -1.0)
+    tol = 1e-12 * np.maximum(np.maximum(di, do), s) ** 2
+    with np.errstate(invalid="ignore"):
+        # FF: a = b = 0, M on the axis at (m, 0)
+        disc_i0, disc_o0 = di * di - sep * sep, do * do
+        out0 = np.sqrt(disc_i0) + side * np.sqrt(disc_o0)
+        # FT: a = 0, b = stroke
+        half = 0.5 * np.hypot(s, 2.0 * sep)
+        disc_i1 = di * di - half * half
+        mm = 0.5 * s + np.sqrt(disc_i1) * (2.0 * sep + 1j * s) / (2.0 * half)
+        disc_o1 = do * do - mm.imag**2
+        out1 = mm.real + side * np.sqrt(disc_o1)
+    ok = (disc_i0 > tol) & (disc_o0 > tol) & (disc_i1 > tol) & (disc_o1 > tol)
+    return np.where(ok, out1 - out0, np.nan)
+
+
 def _gate_residual(sep, stroke, m, xo) -> float:
-    """Output in FT minus output in FF, by forward kinematics (not by the closed form)."""
-    d = _design(sep, stroke, m, xo)
-    st = kinematics(d, np.array([0.0, 0.0]), np.array([0.0, stroke]))
-    if not st.valid.all():
-        return np.nan
-    return float(st.output[1] - st.output[0])
+    """Scalar :func:`_gate_residuals` (for root refinement)."""
+    return float(_gate_residuals(sep, stroke, np.array([m]), xo)[0])
 
 
-def solve_numeric(sep: float, stroke: float, output: float, samples: int = 600
+def solve_numeric(sep: float, stroke: float, output: float, samples: int = 5000
                   ) -> list[ThreeBarDesign]:
     """Robust numerical solution: roots in m of the forward-kinematic gate residual, bracketed
     on a log-spaced grid above the toggle root and refined by Brent's method."""
@@ -158,14 +182,34 @@ def solve_numeric(sep: float, stroke: float, output: float, samples: int = 600
     lo = s / 2.0
     span = 200.0 * (sep + s + abs(output))
     grid = lo + np.geomspace(1e-6 * s, span, samples)
-    r = np.array([_gate_residual(sep, s, m, output) for m in grid])
+    r = _gate_residuals(sep, s, grid, output)
+    fin = np.isfinite(r)
+    brackets = [(grid[i], grid[i + 1])
+                for i in np.nonzero(fin[:-1] & fin[1:] & (r[:-1] * r[1:] < 0.0))[0]]
+    # a root close to the edge of an assembly window may have no grid point beyond it: find
+    # the edge by bisection and bracket against the last assemblable point
+    for i in np.nonzero(fin[:-1] != fin[1:])[0]:
+        good, bad = (grid[i], grid[i + 1]) if fin[i] else (grid[i + 1], grid[i])
+        for _ in range(60):
+            mid = 0.5 * (good + bad)
+            if np.isfinite(_gate_residual(sep, s, mid, output)):
+                good = mid
+            else:
+                bad = mid
+        inner = grid[i] if fin[i] else grid[i + 1]
+        if _gate_residual(sep, s, good, output) * r[i if fin[i] else i + 1] < 0.0:
+            brackets.append((min(inner, good), max(inner, good)))
     out = []
-    for i in range(samples - 1):
-        if np.isfinite(r[i]) and np.isfinite(r[i + 1]) and r[i] * r[i + 1] < 0.0:
-            m = brentq(lambda mm: _gate_residual(sep, s, mm, output), grid[i], grid[i + 1],
+    for lo_m, hi_m in brackets:
+        try:
+            m = brentq(lambda mm: _gate_residual(sep, s, mm, output), lo_m, hi_m,
                        xtol=1e-13 * s, rtol=1e-15)
-            if abs(_gate_residual(sep, s, m, output)) < 1e-9 * s:
-                out.append(_design(sep, s, m, output))
+        except ValueError:
+            # NaN inside the bracket: the sign changes across a stretch where the mechanism
+            # cannot be assembled (e.g. O passing M, the output side flipping), not at a root
+            continue
+        if abs(_gate_residual(sep, s, m, output)) < 1e-9 * s:
+            out.append(_design(sep, s, m, output))
     return out
 
 
@@ -315,8 +359,8 @@ def scan_margin(sep, stroke, m, xo, cr: Criteria | None = None, samples: int = 1
     di = np.hypot(m, sep)
     do = np.abs(xo - m)
     side = np.where(xo >= m, 1.0, -1.0)
-    tol = 1e-12 * np.maximum(np.maximum(di, do), s) ** 2
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        tol = 1e-12 * np.maximum(np.maximum(di, do), s) ** 2
         half = 0.5 * np.hypot(dlt, 2.0 * sep)
         disc_i = di * di - half * half
         mm = 0.5 * dlt + np.sqrt(disc_i) * (2.0 * sep + 1j * dlt) / (2.0 * half)
@@ -503,7 +547,7 @@ def synthesise(sep: float, stroke: float, output: float | None = None,
         warnings.append(f"the output wanders {r.wander:.1f} % of stroke in mid-motion FF-FT/FF-TF "
                         f"(design brief margin {WANDER_MARGIN:g} %); --max-wander "
                         f"{WANDER_MARGIN:g} requires the margin, which with the default limits "
-                        "only sep/stroke of about 0.26-0.43 can meet")
+                        "only sep/stroke of about 0.255-0.40 can meet")
     return ThreeBarAnswer(bool(healthy), d if healthy else d, r, reason, cands, alts, feasible,
                           warnings)
 
@@ -544,7 +588,44 @@ def _alternatives(sep, stroke, output, cr, feasible) -> list[dict]:
             if d is not None:
                 add(d, f"same {'stroke' if which == 'sep' else 'separation'} and output "
                     f"position, nearest healthy {'separation' if which == 'sep' else 'stroke'}")
+    if not alts:
+        # nothing healthy keeps both the separation/stroke ratio and the output: let the output
+        # go and move the ratio, which alone decides whether a healthy gate exists (it scales)
+        r = _nearest_ratio(sep / stroke, cr)
+        if r is not None:
+            for sp, st, what in ((r * stroke, stroke, "same stroke, nearest healthy separation"),
+                                 (sep, sep / r, "same separation, nearest healthy stroke")):
+                d = best_design(sp, st, cr)
+                if d is not None:
+                    add(d, what + ", output position free (largest margin there)")
     return alts
+
+
+def _nearest_ratio(ratio: float, cr: Criteria) -> float | None:
+    """The sep/stroke ratio nearest ``ratio`` (within x100 either way) at which the best design
+    keeps ALT_MARGIN; the gate scales exactly, so health depends on this ratio alone."""
+
+    def marg(r):
+        d = best_design(r, 1.0, cr)
+        return -90.0 if d is None else _margin(cr.evaluate(d), cr)
+
+    fac = np.geomspace(1 / 100, 100, 41)
+    mg = np.array([marg(ratio * f) for f in fac])
+    ok = np.nonzero(mg >= ALT_MARGIN)[0]
+    if len(ok) == 0:
+        return None
+    i = ok[np.argmin(np.abs(np.log(fac[ok])))]
+    j = i - 1 if fac[i] > 1.0 else i + 1
+    good = fac[i]
+    if 0 <= j < len(fac) and mg[j] < ALT_MARGIN:
+        bad = fac[j]
+        for _ in range(25):
+            mid = np.sqrt(good * bad)
+            if marg(ratio * mid) >= ALT_MARGIN:
+                good = mid
+            else:
+                bad = mid
+    return float(ratio * good)
 
 
 def _nearest_by(which, sep, stroke, output, cr):

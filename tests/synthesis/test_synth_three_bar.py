@@ -201,3 +201,39 @@ def test_healthy_range_edges():
             x = float(tb.output_position_for(50, 40, m))
             rep = tb.evaluate(tb._design(50, 40, m, x))
             assert rep.healthy
+
+
+@pytest.mark.parametrize("sep, s, xo", [(200.0, 5.0, 300.0), (1.0, 100.0, 50.0)])
+def test_alternatives_when_the_ratio_itself_is_hopeless(sep, s, xo):
+    # sep/stroke of 40 and of 0.01 lie far outside the range where any healthy gate exists, so
+    # nothing keeping the output or the ratio can be offered: the answer must still suggest
+    # healthy designs (another separation or stroke, output free), each independently checked.
+    ans = tb.synthesise(sep, s, xo)
+    assert not ans.healthy and ans.reason
+    assert ans.alternatives, "no healthy alternatives offered"
+    kept = {("sep", round(a["sep"], 9)) for a in ans.alternatives if a["sep"] == sep}
+    kept |= {("stroke", round(a["stroke"], 9)) for a in ans.alternatives if a["stroke"] == s}
+    assert kept == {("sep", sep), ("stroke", s)}  # one keeps the separation, one the stroke
+    for alt in ans.alternatives:
+        assert alt["healthy"] is True
+        d = tb.ThreeBarDesign(alt["sep"], alt["stroke"], alt["input_link"], alt["output_link"],
+                              alt["output_position"], alt["output_side"])
+        outs, mu = independent_check(d, steps=40)
+        assert abs(outs["FT"] - outs["FF"]) <= 1e-3 * d.stroke
+        assert abs(outs["TF"] - outs["FF"]) <= 1e-3 * d.stroke
+        assert mu >= 45.0 - 1e-6
+
+
+def test_numeric_solution_skips_sign_changes_across_unassemblable_gaps():
+    # Here the gate residual changes sign across m = output (the output link shrinks to zero and
+    # O changes side of M), with no assembly in between: brentq used to meet a NaN there and the
+    # whole command died with an internal error. The only true root is the closed-form one.
+    sep, s, xo = 56.217010679509336, 1.9595755629753917, 315.1392329029357
+    num = tb.solve_numeric(sep, s, xo)
+    closed = tb.solve_closed_form(sep, s, xo)
+    assert len(num) == len(closed) == 1
+    assert abs(num[0].input_link - closed[0].input_link) < 1e-9 * s
+    outs, _ = independent_check(num[0], steps=40)
+    assert abs(outs["FT"] - outs["FF"]) <= 1e-9 * xo
+    ans = tb.synthesise(sep, s, xo, alternatives=False)
+    assert not ans.healthy and ans.reason  # transmission 21 deg, link ratio 0.05
