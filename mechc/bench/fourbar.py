@@ -6,7 +6,8 @@ mechc's path is the one every mechanism's kinematic proof takes: a :class:`Part`
 ``mechc.mech.kinematics.solve`` with the crank's angle given — the rocker then comes from the
 rod's circle meeting the rocker's circle (``_lever_from_rod``), vectorised over all crank
 angles at once, with transmission angles, toggle margins and the loop-closure check computed on
-the way, as in a proof. pylinkage (an optional benchmark dependency, never imported by mechc
+the way, as in a proof; the rocker pin positions are then read with ``position`` (the same
+function a proof's checks use). pylinkage (an optional benchmark dependency, never imported by mechc
 itself) steps its Crank + RRRDyad linkage one position after another.
 """
 
@@ -15,10 +16,11 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
-from mechc.mech.kinematics import solve
+from mechc.mech.kinematics import position, solve
 from mechc.mech.model import Body, Joint, Part
 
 GROUND_LEN, CRANK, COUPLER, ROCKER = 40.0, 10.0, 40.0, 30.0  # mm: Grashof crank-rocker
@@ -33,8 +35,10 @@ def _circle_meet(a, b, ra, rb, upper=True):
     return (a[0] + along * ex - s * h * ey, a[1] + along * ey + s * h * ex)
 
 
+@lru_cache(maxsize=1)
 def mechc_part() -> tuple[Part, tuple[float, float]]:
-    """The four-bar at its design pose (crank at +90°), and the rocker pin there."""
+    """The four-bar at its design pose (crank at +90°), and the rocker pin there (built once:
+    a proof builds its parts once and solves them for many states)."""
     o2 = (GROUND_LEN, 0.0)
     a = (0.0, CRANK)
     b = _circle_meet(o2, a, ROCKER, COUPLER, upper=True)
@@ -50,10 +54,7 @@ def mechc_rocker_pins(crank_angles: np.ndarray) -> np.ndarray:
     """(N, 2) rocker pin positions for absolute crank angles (rad), by mechc's closed form."""
     part, b = mechc_part()
     poses = solve(part, {"crank": np.asarray(crank_angles) - math.pi / 2}, len(crank_angles))
-    th = poses.theta["rocker"]
-    rx, ry = b[0] - GROUND_LEN, b[1]
-    return np.stack([GROUND_LEN + rx * np.cos(th) - ry * np.sin(th),
-                     rx * np.sin(th) + ry * np.cos(th)], axis=1)
+    return np.stack(position(part.bodies[1], poses, b), axis=1)
 
 
 def pylinkage_linkage(steps_per_turn: int):
@@ -79,7 +80,10 @@ class PeerResult:
     positions: int
 
 
-CHUNK = 4096  # states per vectorised call: cache-sized, as a proof's sweep would chunk them
+# states per vectorised call, cache-sized. A proof's sweep chunks larger (budget // (3 bodies),
+# mechc/sim/kinematic.py); for this two-lever part 16384 measured ~25% faster and 65536 slower
+# (memory-bound), so 4096 is neither the best nor the worst case.
+CHUNK = 4096
 
 
 def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResult:

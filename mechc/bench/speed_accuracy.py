@@ -108,8 +108,10 @@ def _solver_ok(r: dict) -> bool:
 
 
 def _dyn(b: Bench, c: Circuit, st: DynSettings, prune: bool | None = None,
-         max_cases: int | None = None) -> tuple[dict, float]:
+         max_cases: int | None = None, freeze: str | None = None) -> tuple[dict, float]:
     kw = {} if prune is None else {"prune": prune}
+    if freeze is not None:
+        kw["freeze"] = freeze
     t0 = _clock()
     r = prove_dynamic(c.design, c.design.spec, b.lib, st, extra=0,
                       max_cases=max_cases if max_cases is not None else c.max_cases, **kw)
@@ -267,7 +269,11 @@ def _types(d: Design) -> dict[str, str]:
 
 # ---- 3. pruned against whole scenes ---------------------------------------------------------
 def pruning(b: Bench, cs: list[Circuit]) -> None:
+    """Whole scene against pruned scenes at the default freeze (``prune.FREEZE``) and with
+    every still body frozen ("all": what pruning could save if dwelling outputs were trusted
+    to stay still; not the default, see docs/performance.md)."""
     b.say("\n== pruned scenes against the whole scene (default settings) ==")
+    variants = (("whole", False, None), ("pruned", True, None), ("pruned_all", True, "all"))
     for c in cs:
         if c.sequential:
             b.say(f"{c.name}: not pruned (MEMORY cells hold state: each change needs the "
@@ -275,47 +281,58 @@ def pruning(b: Bench, cs: list[Circuit]) -> None:
             continue
         repeat = 1 if b.quick and _cells(c.design) > 50 else 2
         st = _default_settings(c.design)
-        best = {}
-        reports = {}
+        best: dict[str, float] = {}
+        reports: dict[str, dict] = {}
         for _ in range(repeat):  # interleaved, best of: the machine is shared
-            for prune in (False, True):
-                r, secs = _dyn(b, c, st, prune=prune)
-                if prune not in best or secs < best[prune]:
-                    best[prune], reports[prune] = secs, r
-        w, p = reports[False], reports[True]
+            for key, prune, freeze in variants:
+                r, secs = _dyn(b, c, st, prune=prune, freeze=freeze)
+                if key not in best or secs < best[key]:
+                    best[key], reports[key] = secs, r
+        w, p, pa = reports["whole"], reports["pruned"], reports["pruned_all"]
         if not p["pruning"]["enabled"]:
             b.say(f"{c.name}: not pruned ({p['pruning']['reason']})")
             continue
-        speed = best[False] / best[True]
+        speed = best["whole"] / best["pruned"]
+        speed_all = best["whole"] / best["pruned_all"]
         d_err = abs(p["max_position_error_fraction"] - w["max_position_error_fraction"])
-        same = (p["passed"] == w["passed"] and set(p["failure_kinds"]) == set(w["failure_kinds"]))
-        for prune, r in ((False, w), (True, p)):
-            b.row(section="pruning", circuit=c.name, level="dynamic",
-                  variant="pruned" if prune else "whole", dt_s=st.dt, iterations=st.iterations,
-                  move_time_s=st.move_time, cases=r["cases"], seconds=best[prune],
-                  seconds_per_case=best[prune] / max(1, r["cases"]),
+        same = _same_verdict(w, p)
+        for key, r in reports.items():
+            b.row(section="pruning", circuit=c.name, level="dynamic", variant=key, dt_s=st.dt,
+                  iterations=st.iterations, move_time_s=st.move_time, cases=r["cases"],
+                  seconds=best[key], seconds_per_case=best[key] / max(1, r["cases"]),
                   error_fraction=r["max_position_error_fraction"],
                   max_violation_mm=r["max_joint_violation_mm"], passed=r["passed"],
                   solver_ok=_solver_ok(r), failure_kinds=_kinds(r), steps=r["steps"],
-                  default=prune == PRUNE_DEFAULT)
+                  default=(key == "pruned") == PRUNE_DEFAULT and key != "pruned_all")
         pr = p["pruning"]
         solver = solver_speedup(b, c)
-        b.say(f"{c.name:11s} whole {best[False]:6.2f} s  pruned {best[True]:6.2f} s  = "
-              f"{speed:4.2f}x (solver alone {solver:4.2f}x)  error "
+        b.say(f"{c.name:11s} whole {best['whole']:6.2f} s  pruned {best['pruned']:6.2f} s  = "
+              f"{speed:4.2f}x (solver alone {solver:4.2f}x; all still bodies frozen "
+              f"{best['pruned_all']:5.2f} s = {speed_all:4.2f}x, verdict "
+              f"{'same' if _same_verdict(w, pa) else 'DIFFERENT'})  error "
               f"{w['max_position_error_fraction']:.5f} -> {p['max_position_error_fraction']:.5f}"
-              "  joint "
-              f"{w['max_joint_violation_mm']:.4f} -> {p['max_joint_violation_mm']:.4f} mm  "
-              f"verdict {'same' if same else 'DIFFERENT'}  scene {pr['mean_cells']:.1f} of "
-              f"{pr['circuit_cells']} cells, {pr['mean_constraints']:.0f} of "
-              f"{w['scene']['constraints']} constraints, {pr['escalated_cases']} escalated")
+              f" ({pa['max_position_error_fraction']:.5f})  joint "
+              f"{w['max_joint_violation_mm']:.4f} -> {p['max_joint_violation_mm']:.4f} mm "
+              f"({pa['max_joint_violation_mm']:.4f})  verdict {'same' if same else 'DIFFERENT'}"
+              f"  scene {pr['mean_cells']:.1f} of {pr['circuit_cells']} cells, "
+              f"{pr['mean_constraints']:.0f} of {w['scene']['constraints']} constraints "
+              f"({pa['pruning']['mean_constraints']:.0f} all frozen), "
+              f"{pr['escalated_cases']} of {p['cases']} escalated")
         b.summary[f"{c.name}_pruned_speedup"] = round(speed, 3)
+        b.summary[f"{c.name}_pruned_all_frozen_speedup"] = round(speed_all, 3)
         b.summary[f"{c.name}_pruned_solver_speedup"] = round(solver, 3)
         b.summary[f"{c.name}_pruned_error_delta"] = round(d_err, 6)
         b.summary[f"{c.name}_pruned_same_verdict"] = same
+        b.summary[f"{c.name}_pruned_escalated"] = f"{pr['escalated_cases']}/{p['cases']}"
         if c.name == "random30":
             b.summary["pruned_speedup"] = round(speed, 3)
+            b.summary["pruned_all_frozen_speedup"] = round(speed_all, 3)
             b.summary["pruned_solver_speedup"] = round(solver, 3)
             b.summary["pruned_error_delta"] = round(d_err, 6)
+
+
+def _same_verdict(a: dict, b: dict) -> bool:
+    return a["passed"] == b["passed"] and set(a["failure_kinds"]) == set(b["failure_kinds"])
 
 
 def solver_speedup(b: Bench, c: Circuit, cases: int = 4, steps: int = 150) -> float:
@@ -696,7 +713,8 @@ def run(quick: bool, out: Path, write_model: Path | None) -> dict:
     b.summary["wall_seconds"] = round(time.perf_counter() - t_start, 1)
     b.say(f"\nwrote {out / 'speed_accuracy.csv'}, {out / 'speed_accuracy.png'}, "
           f"{out / 'stability.png'}, {out / 'accuracy_model.json'}")
-    order = ["pruned_speedup", "pruned_solver_speedup", "pruned_error_delta", "default_error",
+    order = ["pruned_speedup", "pruned_all_frozen_speedup", "pruned_solver_speedup",
+             "pruned_error_delta", "default_error",
              "default_case_seconds", "kinematic_vs_pylinkage", "kinematic_vs_pylinkage_step",
              "dynamic_vs_bare_pymunk"]
     for k, v in b.summary.items():

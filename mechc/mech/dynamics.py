@@ -32,12 +32,13 @@ import pymunk.batch as pb
 
 from mechc.library import Library
 from mechc.mech.assemble import Mechanism
-from mechc.mech.evaluate import settle, signal_of
+from mechc.mech.evaluate import settle
 from mechc.mech.kinematics import Poses
 from mechc.mech.model import GROUND, Body
 
 N = 1000.0  # newtons -> pymunk force units (kg mm / s^2)
 FAR = 1000.0  # mm: how far behind a contact face its slide-joint anchor sits
+MOVE_SAMPLES = 41  # closed-form samples along an input move (boundary drive and reference)
 
 
 @dataclass
@@ -75,6 +76,7 @@ class MoveResult:
     servo_lag: float  # mm, largest distance between servo and input slider
     steps: int
     servo_lag_end: float = 0.0  # mm, distance between servo and input slider at the end
+    watched: dict[str, np.ndarray] = field(default_factory=dict)  # Scene.watch sliders' u (mm)
 
 
 @dataclass
@@ -108,11 +110,15 @@ class Scene:
     touches: list = field(default_factory=list)  # (joint, shapes) of shape contacts
     state: dict[str, float] = field(default_factory=dict)  # current input values
     mem_state: dict[str, float] = field(default_factory=dict)  # stateful cells (MEMORY)
+    watch: list[str] = field(default_factory=list)  # slider bodies whose u each move records
 
     # ---- building ---------------------------------------------------------------------------
     @staticmethod
     def build(mech: Mechanism, lib: Library, types: dict[str, str], settings: DynSettings,
-              start: dict[str, float], cells: list[str] | None = None) -> Scene:
+              start: dict[str, float], cells: list[str] | None = None,
+              poses: Poses | None = None) -> Scene:
+        """``poses``: the closed form of ``start`` if the caller has it (its first sample is
+        used), so a scene per input change does not solve the whole mechanism again."""
         sc = Scene(mech, lib, types, settings, list(cells if cells is not None else mech.order))
         sc.space.iterations = settings.iterations
         sc.space.gravity = (0, 0)
@@ -126,7 +132,10 @@ class Scene:
         for j in rods:
             if j.a not in own:
                 sc.boundary.add(j.a)
-        poses = sc._kinematic({k: np.array([v]) for k, v in start.items()})
+        if poses is None:
+            poses = sc._kinematic({k: np.array([v]) for k, v in start.items()})
+        else:
+            sc._last_state = {k: float(v[0]) for k, v in poses.state.items()}
         for p in parts:
             for b in p.bodies:
                 sc._add_body(b, poses, kinematic=False)
@@ -284,89 +293,135 @@ class Scene:
 
     # ---- measuring --------------------------------------------------------------------------
     def _prepare(self) -> None:
+        """Index arrays for measuring every joint in a few numpy passes per step: the per-step
+        Python work must stay small against pymunk's own step, or it, not the solver, sets
+        what a scene costs (and a pruned scene saves nothing)."""
         order = list(self.bodies)
+        n = len(order)
         self._order = order
         self._pos = {bid: i for i, bid in enumerate(order)}
         js = self.joints
-        self._ja = np.array([j.ia for j in js], dtype=np.int64)
-        self._jb = np.array([j.ib for j in js], dtype=np.int64)
-        self._la = np.array([j.la for j in js], dtype=float).reshape(-1, 2)
-        self._lb = np.array([j.lb for j in js], dtype=float).reshape(-1, 2)
-        kinds = np.array([j.kind for j in js])
+        m = len(js)
+        ja = np.array([j.ia for j in js], dtype=np.int64)
+        jb = np.array([j.ib for j in js], dtype=np.int64)
+        kinds = np.array([j.kind for j in js], dtype=object)
         self._is_pivot = kinds == "pivot"
         self._is_rod = kinds == "rod"
         self._is_contact = kinds == "contact"
         self._is_groove = kinds == "groove"
         self._bilateral = ~self._is_contact
-        self._la2 = np.array([j.extra[0] if j.kind == "groove" else (0.0, 0.0) for j in js],
-                             dtype=float).reshape(-1, 2)
+        self._contact_rows = np.flatnonzero(self._is_contact)
+        self._groove_rows = np.flatnonzero(self._is_groove)
         self._len = np.array([j.extra[0] if j.kind in ("rod", "contact") else 0.0
                               for j in js], dtype=float)
+        la = np.array([j.la for j in js], dtype=float).reshape(-1, 2)
+        lb = np.array([j.lb for j in js], dtype=float).reshape(-1, 2)
+        la2 = np.array([js[i].extra[0] for i in self._groove_rows], dtype=float).reshape(-1, 2)
+        # every anchor (a, b, groove ends) in one array; ground is the extra row n
+        idx = np.concatenate([ja, jb, ja[self._groove_rows]])
+        self._m = m
+        self._widx = np.where(idx < 0, n, idx)
+        loc = np.concatenate([la, lb, la2]).reshape(-1, 2)
+        self._wloc_c = loc[:, 0] + 1j * loc[:, 1]
         self._buf = pb.Buffer()
-        self._buf.clear()
         pb.get_space_bodies(self.space, pb.BodyFields.BODY_ID, self._buf)
         ids = np.frombuffer(self._buf.int_buf(), dtype=np.int64)
         mine = {self.bodies[k].id: i for i, k in enumerate(order)}
-        self._batch_index = np.array([mine.get(int(i), -1) for i in ids])
+        where = np.array([mine.get(int(i), -1) for i in ids], dtype=np.int64)
+        self._src = np.flatnonzero(where >= 0)
+        self._dst = where[self._src]
         self._dynamic = np.array([self.bodies[k].body_type == pymunk.Body.DYNAMIC
-                                  for k in order])
+                                  for k in order], dtype=bool)
+        self._spin_free = np.array([_spin_is_invisible(self, k) for k in order], dtype=bool)
+        self._P = np.zeros((n + 1, 2))  # positions, ground row last
+        self._A = np.zeros(n + 1)  # angles
+        self._V = np.zeros((n, 3))  # vx, vy, angular velocity
+        self._fields = (pb.BodyFields.POSITION | pb.BodyFields.ANGLE | pb.BodyFields.VELOCITY
+                        | pb.BodyFields.ANGULAR_VELOCITY)
+
+    def _read(self) -> None:
+        """One batch read of every body's position, angle and velocities."""
+        self._buf.clear()
+        pb.get_space_bodies(self.space, self._fields, self._buf)
+        f = np.frombuffer(self._buf.float_buf(), dtype=np.float64).reshape(-1, 6)[self._src]
+        self._P[self._dst] = f[:, :2]
+        self._A[self._dst] = f[:, 2]
+        self._V[self._dst] = f[:, 3:]
 
     def _state(self):
         """Positions (n, 2) and angles (n,) of the scene's bodies in self._order."""
-        self._buf.clear()
-        pb.get_space_bodies(self.space, pb.BodyFields.POSITION | pb.BodyFields.ANGLE, self._buf)
-        f = np.frombuffer(self._buf.float_buf(), dtype=np.float64).reshape(-1, 3)
-        pos = np.zeros((len(self._order), 2))
-        ang = np.zeros(len(self._order))
-        sel = self._batch_index >= 0
-        pos[self._batch_index[sel]] = f[sel, :2]
-        ang[self._batch_index[sel]] = f[sel, 2]
-        return pos, ang
-
-    def _world(self, idx: np.ndarray, local: np.ndarray, pos, ang) -> np.ndarray:
-        out = local.copy()
-        m = idx >= 0
-        if m.any():
-            c, s = np.cos(ang[idx[m]]), np.sin(ang[idx[m]])
-            lx, ly = local[m, 0], local[m, 1]
-            out[m, 0] = pos[idx[m], 0] + lx * c - ly * s
-            out[m, 1] = pos[idx[m], 1] + lx * s + ly * c
-        return out
+        if not hasattr(self, "_order"):
+            self._prepare()
+        self._read()
+        n = len(self._order)
+        return self._P[:n].copy(), self._A[:n].copy()
 
     def violations(self, pos, ang) -> np.ndarray:
         """Per joint: anchor separation (pivot), length error (rod), distance of the pin from
-        its slot segment (groove, guide), overrun (contact)."""
-        wa = self._world(self._ja, self._la, pos, ang)
-        wb = self._world(self._jb, self._lb, pos, ang)
-        d = wb - wa
-        dist = np.hypot(d[:, 0], d[:, 1])
-        v = np.where(self._is_pivot, dist, 0.0)
-        v = np.where(self._is_rod, np.abs(dist - self._len), v)
-        v = np.where(self._is_contact, np.maximum(0.0, self._len - dist), v)
-        if self._is_groove.any():
-            a1 = self._world(self._ja, self._la2, pos, ang)
-            seg = a1 - wa
-            ss = np.maximum((seg * seg).sum(axis=1), 1e-12)
-            t = np.clip((d * seg).sum(axis=1) / ss, 0.0, 1.0)
-            off = wb - (wa + t[:, None] * seg)
-            v = np.where(self._is_groove, np.hypot(off[:, 0], off[:, 1]), v)
+        its slot segment (groove, guide), overrun (contact); a non-finite pose is infinite."""
+        if not hasattr(self, "_order"):
+            self._prepare()
+        n = len(self._order)
+        self._P[:n] = pos
+        self._A[:n] = ang
+        return self._violations()
+
+    def _violations(self) -> np.ndarray:
+        idx, m = self._widx, self._m
+        rot = np.exp(1j * self._A)  # anchors as complex numbers: one rotation per body
+        w = self._P[:, 0][idx] + 1j * self._P[:, 1][idx] + self._wloc_c * rot[idx]
+        d = w[m:2 * m] - w[:m]
+        dist = np.abs(d)
+        v = np.abs(dist - self._len)  # pivot (length 0) and rod
+        cr = self._contact_rows
+        v[cr] = np.maximum(0.0, self._len[cr] - dist[cr])
+        g = self._groove_rows
+        if len(g):
+            wa = w[g]
+            seg = w[2 * m:] - wa
+            ss = np.maximum(np.abs(seg) ** 2, 1e-12)
+            t = np.clip((d[g] * seg.conj()).real / ss, 0.0, 1.0)
+            v[g] = np.abs(w[m + g] - wa - t * seg)
+        v[np.isnan(v)] = np.inf
         return v
 
     def touch_overrun(self) -> float:
-        """Deepest interpenetration (mm) of any shape contact now."""
+        """Deepest interpenetration (mm) of any shape contact now, measured geometrically: the
+        roller's radius less its centre's distance to the profile (a polyline) or to the
+        other circle. (pymunk's own contact query returns nothing for most touching pairs.)"""
         worst = 0.0
         for _, shapes in self.touches:
             roller = shapes[-1]
-            for sh in shapes[:-1]:
-                if not sh.bb.intersects(roller.bb):
-                    continue
-                try:
-                    points = sh.shapes_collide(roller).points
-                except AssertionError:  # pymunk 7.3 asserts on an empty contact set
-                    continue
-                for p in points:
-                    worst = max(worst, -p.distance)
+            c = roller.body.local_to_world(roller.offset)
+            first = shapes[0]
+            if isinstance(first, pymunk.Circle):
+                o = first.body.local_to_world(first.offset)
+                d = math.hypot(c[0] - o[0], c[1] - o[1])
+                worst = max(worst, first.radius + roller.radius - d)
+                continue
+            d = self._polyline_distance(shapes, c)
+            worst = max(worst, roller.radius - d)
         return worst
+
+    def _polyline_distance(self, shapes, c) -> float:
+        """Distance from world point ``c`` to a touch's profile segments (numpy, vectorised)."""
+        cache = self.__dict__.setdefault("_profiles", {})
+        key = id(shapes)
+        if key not in cache:
+            a = np.array([[s.a.x, s.a.y] for s in shapes[:-1]])
+            b = np.array([[s.b.x, s.b.y] for s in shapes[:-1]])
+            cache[key] = (a, b - a)
+        a, ab = cache[key]
+        body = shapes[0].body
+        ca, sa = math.cos(body.angle), math.sin(body.angle)
+        # the point in the profile body's frame (segments are stored in that frame)
+        dx, dy = c[0] - body.position.x, c[1] - body.position.y
+        px, py = ca * dx + sa * dy, -sa * dx + ca * dy
+        rx, ry = px - a[:, 0], py - a[:, 1]
+        ll = ab[:, 0] ** 2 + ab[:, 1] ** 2
+        t = np.clip((rx * ab[:, 0] + ry * ab[:, 1]) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+        ex, ey = rx - t * ab[:, 0], ry - t * ab[:, 1]
+        return float(np.sqrt(np.min(ex * ex + ey * ey)))
 
     def pose_of(self, bid: str, pos, ang) -> Poses:
         """The scene's pose of one body in the closed form's terms (for signals)."""
@@ -386,18 +441,60 @@ class Scene:
         return (pos[i, 0] - rx) * ax + (pos[i, 1] - ry) * ay
 
     def outputs_now(self, pos, ang) -> dict[str, float]:
-        out = {}
+        """Output signals (0..1) of the outputs this scene holds, for a pose of the scene."""
+        if not hasattr(self, "_out_names"):
+            self._prepare_outputs()
+        i = self._out_body
+        if not len(i):
+            return {}
+        pos, ang = np.asarray(pos), np.asarray(ang)
+        c, s = np.cos(ang[i]), np.sin(ang[i])
+        qx, qy = self._out_q[:, 0], self._out_q[:, 1]
+        x = pos[i, 0] + qx * c - qy * s - self._out_off[:, 0]
+        y = pos[i, 1] + qx * s + qy * c - self._out_off[:, 1]
+        # sliders: only the travel along the axis counts (as ``pose_of`` reads them)
+        sl = self._out_slider
+        if sl.any():
+            ax, ay = self._out_axis[:, 0], self._out_axis[:, 1]
+            u = (pos[i, 0] - self._out_ref[:, 0]) * ax + (pos[i, 1] - self._out_ref[:, 1]) * ay
+            x = np.where(sl, self._out_p[:, 0] + u * ax - self._out_off[:, 0], x)
+            y = np.where(sl, self._out_p[:, 1] + u * ay - self._out_off[:, 1], y)
+        sig = x * self._out_g[:, 0] + y * self._out_g[:, 1]
+        return dict(zip(self._out_names, sig.tolist()))
+
+    def _prepare_outputs(self) -> None:
+        """Per output: its body, design point and off->on direction, so every output signal
+        comes from one vectorised pass (``signal_of`` on the scene's pose, for all at once)."""
+        if not hasattr(self, "_pos"):
+            self._pos = {bid: i for i, bid in enumerate(self.bodies)}
+        names, body, q, p, off, g, slider, axis, ref = [], [], [], [], [], [], [], [], []
         for name, (owner, pin) in self.mech.outputs.items():
             if not owner.startswith("in:") and owner not in self.cells:
                 continue
             t = self.mech.owner_part(owner).terminals[pin]
-            out[name] = float(signal_of(t, self._index[t.body],
-                                           self.pose_of(t.body, pos, ang))[0])
-        return out
+            rx, ry = self.ref[t.body]
+            dx, dy = t.on[0] - t.off[0], t.on[1] - t.off[1]
+            nn = dx * dx + dy * dy
+            names.append(name)
+            body.append(self._pos[t.body])
+            q.append((t.design_point[0] - rx, t.design_point[1] - ry))
+            p.append(t.design_point)
+            off.append(t.off)
+            g.append((dx / nn, dy / nn))
+            slider.append(self.kind[t.body] == "slider")
+            axis.append(self.axis.get(t.body, (0.0, 0.0)))
+            ref.append((rx, ry))
+        self._out_names = names
+        self._out_body = np.array(body, dtype=np.int64)
+        self._out_q, self._out_p, self._out_off, self._out_g, self._out_axis, self._out_ref = (
+            np.array(v, dtype=float).reshape(-1, 2) for v in (q, p, off, g, axis, ref))
+        self._out_slider = np.array(slider, dtype=bool)
 
     # ---- running ----------------------------------------------------------------------------
-    def move(self, name: str, target: float) -> MoveResult:
-        """Move input ``name`` to ``target`` (0 or 1) and hold until settled (or time out)."""
+    def move(self, name: str, target: float, reference: Poses | None = None) -> MoveResult:
+        """Move input ``name`` to ``target`` (0 or 1) and hold until settled (or time out).
+        ``reference``: the closed form along the move if the caller has it (MOVE_SAMPLES
+        samples of the moving input from its current value to ``target``, the others held)."""
         st = self.settings
         if not hasattr(self, "_order"):
             self._prepare()
@@ -409,14 +506,20 @@ class Scene:
         s0 = servo.position
         n_move = max(1, int(round(st.move_time / st.dt)))
         n_hold = max(1, int(round(st.settle_time / st.dt)))
+        ib, nb = self._pos[sbody], len(self._order)
         # closed-form trajectory of the boundary bodies and the outputs along the move
-        samples = np.linspace(0.0, 1.0, 41)
-        vals = {k: np.full(len(samples), v) for k, v in self.state.items()}
-        vals[name] = start + (target - start) * samples
-        ref = self._kinematic(vals)
+        samples = np.linspace(0.0, 1.0, MOVE_SAMPLES)
+        if reference is None:
+            vals = {k: np.full(len(samples), v) for k, v in self.state.items()}
+            vals[name] = start + (target - start) * samples
+            ref = self._kinematic(vals)
+        else:
+            ref = reference
+            self._last_state = {k: float(v[-1]) for k, v in ref.state.items()}
         from mechc.mech.evaluate import output_signals
 
         ref_out = output_signals(self.mech, ref)
+        watched: dict[str, list[float]] = {}
         ts, outs, refs = [], {k: [] for k in self.mech.outputs}, {k: [] for k in
                                                                  self.mech.outputs}
         max_v, worst, lag, max_pen = 0.0, "", 0.0, 0.0
@@ -454,21 +557,24 @@ class Scene:
                         kb.velocity = ((gx - kb.position[0]) / st.dt,
                                        (gy - kb.position[1]) / st.dt)
             self.space.step(st.dt)
-            pos, ang = self._state()
-            v = self.violations(pos, ang)
+            self._read()
+            v = self._violations()
             if len(v):
                 vb = np.where(self._bilateral, v, 0.0)
                 i = int(np.argmax(vb))
                 if vb[i] > max_v:
                     max_v, worst = float(vb[i]), self.joints[i].id
-                max_pen = max(max_pen, float(np.max(np.where(self._is_contact, v, 0.0))))
+                if len(self._contact_rows):
+                    max_pen = max(max_pen, float(np.max(v[self._contact_rows])))
             if self.touches:
                 max_pen = max(max_pen, self.touch_overrun())
-            bp = body.position
-            lag = max(lag, math.hypot(bp[0] - servo.position[0], bp[1] - servo.position[1]))
+            bp = self._P[ib]
+            lag = max(lag, math.hypot(bp[0] - want[0], bp[1] - want[1]))
             if step % st.record_every == 0 or step == total:
-                o = self.outputs_now(pos, ang)
+                o = self.outputs_now(self._P[:nb], self._A[:nb])
                 ts.append(t)
+                for bid in self.watch:
+                    watched.setdefault(bid, []).append(self.body_u(bid, self._P[:nb]))
                 k = frac * (len(samples) - 1)
                 for nm in o:
                     outs[nm].append(o[nm])
@@ -499,15 +605,36 @@ class Scene:
                           {k: np.array(v) for k, v in refs.items() if v}, final, max_v, worst,
                           max_pen, settle, lag, step,
                           math.hypot(body.position[0] - servo.position[0],
-                                     body.position[1] - servo.position[1]))
+                                     body.position[1] - servo.position[1]),
+                          {k: np.array(v) for k, v in watched.items()})
 
     def _max_speed(self) -> float:
-        """Largest speed (mm/s, or mm/s at 30 mm radius for levers) of a free body."""
-        best = 0.0
-        for bid in self._order:
-            b = self.bodies[bid]
-            if b.body_type != pymunk.Body.DYNAMIC:
-                continue
-            sp = math.hypot(*b.velocity) + abs(b.angular_velocity) * 30.0
-            best = max(best, sp)
-        return best
+        """Largest speed (mm/s, or mm/s at 30 mm radius for levers) of a free body, as of the
+        last read of the scene. A roller's spin about its own centre is not motion (an idler
+        driven by a powered roller spins for ever at rest)."""
+        V = self._V[self._dynamic]
+        if not len(V):
+            return 0.0
+        spin = np.where(self._spin_free[self._dynamic], 0.0, np.abs(V[:, 2]))
+        return float(np.max(np.hypot(V[:, 0], V[:, 1]) + spin * 30.0))
+
+
+def _spin_is_invisible(scene: Scene, bid: str) -> bool:
+    """Whether turning body ``bid`` about its centre changes nothing another body or an output
+    can see: a dynamic body whose every constraint anchor is at its centre and whose every
+    shape is a circle centred there, and which carries no output terminal."""
+    b = scene.bodies[bid]
+    if b.body_type != pymunk.Body.DYNAMIC or not b.shapes:
+        return False
+    for owner, pin in scene.mech.outputs.values():
+        if owner.startswith("in:") or owner in scene.cells:
+            if scene.mech.owner_part(owner).terminals[pin].body == bid:
+                return False
+    for sh in b.shapes:
+        if not isinstance(sh, pymunk.Circle) or abs(sh.offset) > 1e-9:
+            return False
+    for c in b.constraints:
+        anchor = getattr(c, "anchor_a" if c.a is b else "anchor_b", None)
+        if anchor is None or abs(anchor) > 1e-9:
+            return False
+    return True

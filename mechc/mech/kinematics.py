@@ -35,6 +35,10 @@ class Poses:
     singular_margin: dict[str, np.ndarray] = field(default_factory=dict)  # joint -> degrees
     transmission: dict[str, np.ndarray] = field(default_factory=dict)  # joint -> degrees
     state: dict[str, np.ndarray] = field(default_factory=dict)  # stateful cell -> new state
+    # world points a closed form placed while solving, (body, x0, y0) -> (x, y): the closure
+    # check reuses them instead of re-deriving them through trig (private to ``solve``)
+    placed: dict[tuple[str, float, float], tuple[np.ndarray, np.ndarray]] = field(
+        default_factory=dict, repr=False, compare=False)
 
     def known(self, body: str) -> bool:
         return body == GROUND or body in self.u or body in self.theta
@@ -54,6 +58,16 @@ def _cross(a, b):
     return a[0] * b[1] - a[1] * b[0]
 
 
+def cos_sin(th) -> tuple[np.ndarray, np.ndarray]:
+    """cos and sin of ``th`` from one tangent of the half angle: numpy vectorises float64 tan
+    but sends cos and sin to scalar libm (~5x slower each); the results agree with libm to
+    one ulp (|error| <= 2.3e-16, checked in tests/perf/test_perf_kinematics.py)."""
+    t = np.tan(np.multiply(th, 0.5))
+    t2 = t * t
+    q = 1.0 / (1.0 + t2)
+    return (1.0 - t2) * q, (t + t) * q
+
+
 def displacement(body: Body | None, poses: Poses, p: Point) -> tuple[np.ndarray, np.ndarray]:
     """Displacement (dx, dy) of the design point ``p`` of ``body`` in every state."""
     if body is None:
@@ -63,7 +77,7 @@ def displacement(body: Body | None, poses: Poses, p: Point) -> tuple[np.ndarray,
         return u * body.axis[0], u * body.axis[1]
     th = poses.theta[body.id]
     rx, ry = p[0] - body.pivot[0], p[1] - body.pivot[1]
-    c, s = np.cos(th), np.sin(th)
+    c, s = cos_sin(th)
     dx, dy = rx * c - ry * s - rx, rx * s + ry * c - ry
     if body.kind == "link":
         tx, ty = poses.xy[body.id]
@@ -72,6 +86,15 @@ def displacement(body: Body | None, poses: Poses, p: Point) -> tuple[np.ndarray,
 
 
 def position(body: Body | None, poses: Poses, p: Point) -> tuple[np.ndarray, np.ndarray]:
+    if body is not None and body.kind == "lever":  # pivot + R(θ)·arm: fewer array passes
+        c, s = cos_sin(poses.theta[body.id])
+        rx, ry = p[0] - body.pivot[0], p[1] - body.pivot[1]
+        x, y = rx * c, rx * s
+        x -= ry * s
+        y += ry * c
+        x += body.pivot[0]
+        y += body.pivot[1]
+        return x, y
     dx, dy = displacement(body, poses, p)
     return p[0] + dx, p[1] + dy
 
@@ -371,35 +394,67 @@ def _slider_from_rod(j: Joint, slider: Body, other: Body, poses: Poses, size: in
 def _lever_from_rod(j: Joint, lever: Body, other: Body, poses: Poses, size: int):
     """A rod from a known body to a pin on the lever: the pin is where the lever's circle
     (about its pivot) meets the rod's circle (about the known end), on the side of the line of
-    centres the design pose is on."""
+    centres the design pose is on.
+
+    Worked in units of the centre distance d (D = rod end - pivot): the pin sits at
+    A·D ± H·D⊥ from the pivot with A = 1/2 + (r² - L²)/(2d²) and H² = r²/d² - A², so one
+    division, one square root and one arctan2 place it; the transmission angle comes from the
+    same numbers (law of cosines: arm·rod = (d² - r² - L²)/2, |arm×rod| = H·d²) by arctan2,
+    which unlike arccos of a cosine stays accurate at the toggle (H -> 0)."""
     mine, theirs = (j.pb, j.pa) if j.b == lever.id else (j.pa, j.pb)
     P = lever.pivot
-    r = float(np.hypot(mine[0] - P[0], mine[1] - P[1]))
-    L = j.length
+    r2 = (mine[0] - P[0]) ** 2 + (mine[1] - P[1]) ** 2
+    L2 = j.length * j.length
     cx, cy = position(other, poses, theirs)
     dx, dy = cx - P[0], cy - P[1]
-    d = np.hypot(dx, dy)
-    a = (r * r - L * L + d * d) / (2 * d)
-    h2 = r * r - a * a
-    ok = (h2 >= 0) & (d > 0)
-    h = np.sqrt(np.where(ok, h2, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / (dx * dx + dy * dy)  # d = 0 or NaN: A, H2 NaN below, the state is bad
+        A = 0.5 * (r2 - L2) * inv
+        A += 0.5
+        H2 = r2 * inv - A * A
+    ok = H2 >= 0
+    Hc = np.sqrt(np.maximum(H2, 0.0))  # past the toggle: the pin on the line of centres
     side = float(np.sign(_cross((theirs[0] - P[0], theirs[1] - P[1]),
                                 (mine[0] - P[0], mine[1] - P[1])))) or 1.0
-    ex, ey = dx / d, dy / d
-    px = P[0] + a * ex - side * h * ey
-    py = P[1] + a * ey + side * h * ex
-    theta = np.arctan2(py - P[1], px - P[0]) - np.arctan2(mine[1] - P[1], mine[0] - P[0])
-    theta = (theta + np.pi) % (2 * np.pi) - np.pi
-    poses.theta[lever.id] = np.where(ok, theta, np.nan) * np.ones(size)
-    poses.mark(lever.id, ~np.broadcast_to(ok, (size,))
-               | np.broadcast_to(poses.bad.get(other.id if other else GROUND,
-                                               np.zeros(size, bool)), (size,)))
-    # transmission: angle between the rod and the lever arm (90° is ideal)
-    rx, ry = px - P[0], py - P[1]
-    qx, qy = cx - px, cy - py
-    gamma = _angle_between_lines(rx, ry, qx, qy)
-    poses.transmission[j.id] = gamma * np.ones(size)
-    poses.singular_margin[j.id] = gamma * np.ones(size)
+    H = np.where(ok, Hc, np.nan)  # unsolved states: NaN pin, NaN angle
+    rx, ry = A * dx, A * dy
+    if side > 0:
+        rx -= H * dy
+        ry += H * dx
+    else:
+        rx += H * dy
+        ry -= H * dx
+    phi0 = float(np.arctan2(mine[1] - P[1], mine[0] - P[0]))
+    theta = np.arctan2(ry, rx)
+    theta -= phi0  # in [-pi - phi0, pi - phi0]: wrap the one side that can leave [-pi, pi)
+    if phi0 > 0:
+        np.add(theta, 2 * np.pi, out=theta, where=theta < -np.pi)
+    else:
+        np.subtract(theta, 2 * np.pi, out=theta, where=theta >= np.pi)
+    poses.theta[lever.id] = np.broadcast_to(theta, (size,)).copy()
+    other_bad = poses.bad.get(other.id if other else GROUND)
+    bad = ~np.broadcast_to(ok, (size,))
+    poses.mark(lever.id, bad if other_bad is None else bad | other_bad)
+    rx += P[0]
+    ry += P[1]
+    poses.placed[_key(lever, mine)] = (rx, ry)
+    if other is not None:
+        poses.placed[_key(other, theirs)] = (cx, cy)
+    # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the toggle
+    cos_part = np.abs(0.5 - 0.5 * (r2 + L2) * inv)
+    gamma = np.broadcast_to(np.degrees(np.arctan2(Hc, cos_part)), (size,))
+    poses.transmission[j.id] = gamma.copy()
+    poses.singular_margin[j.id] = gamma.copy()
+
+
+def _key(body: Body | None, p: Point) -> tuple[str, float, float]:
+    return (GROUND if body is None else body.id, float(p[0]), float(p[1]))
+
+
+def _placed_position(body: Body | None, poses: Poses, p: Point):
+    """``position``, reusing the point where a closed form of this solve placed it."""
+    hit = poses.placed.get(_key(body, p))
+    return hit if hit is not None else position(body, poses, p)
 
 
 def _check_consistency(part: Part, bodies, poses: Poses, size: int, tol: float = 1e-6) -> None:
@@ -414,11 +469,16 @@ def _check_consistency(part: Part, bodies, poses: Poses, size: int, tol: float =
             bx_, by_ = position(b, poses, j.pb)
             gap = (bx_ - ax_) * j.normal[0] + (by_ - ay_) * j.normal[1]
             viol = np.broadcast_to(gap < -tol * max(1.0, abs(j.pa[0])), (size,))
-        elif j.kind == "rod":
-            ax_, ay_ = position(a, poses, j.pa)
-            bx_, by_ = position(b, poses, j.pb)
-            viol = np.broadcast_to(np.abs(np.hypot(bx_ - ax_, by_ - ay_) - j.length) > 1e-6,
-                                   (size,))
+        elif j.kind == "rod":  # |distance - length| > 1e-6, squared: no square root
+            ax_, ay_ = _placed_position(a, poses, j.pa)
+            bx_, by_ = _placed_position(b, poses, j.pb)
+            ex, ey = bx_ - ax_, by_ - ay_
+            g2 = ex * ex
+            g2 += ey * ey
+            viol = g2 > (j.length + 1e-6) ** 2
+            if j.length > 1e-6:
+                viol |= g2 < (j.length - 1e-6) ** 2
+            viol = np.broadcast_to(viol, (size,))
         elif j.kind == "pin":
             ax_, ay_ = position(a, poses, j.pa)
             bx_, by_ = position(b, poses, j.pa)

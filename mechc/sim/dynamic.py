@@ -30,7 +30,7 @@ from mechc.pipeline import Design
 from mechc.sim.cases import gray_tour, random_walk
 from mechc.sim.kinematic import sweep
 from mechc.sim.logic import check_interface
-from mechc.sim.prune import blocker, run_case
+from mechc.sim.prune import FREEZE, blocker, run_case
 from mechc.spec.model import Spec
 
 MAX_LISTED = 50
@@ -50,12 +50,14 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                   tolerance: float = 0.05, extra: int = 16, seed: int = 0,
                   progress: Callable[[int, int], None] | None = None,
                   cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
-                  max_cases: int | None = None, record: list | None = None) -> dict:
+                  max_cases: int | None = None, record: list | None = None,
+                  freeze: str | None = None) -> dict:
     """``prune``: each change runs on its own scene holding only what can move the outputs
     (``mechc.sim.prune``; every change then starts from the closed-form rest pose); else one
     scene of the whole mechanism (or of ``cells``) runs the whole tour. ``max_cases`` keeps
     the first changes of the plan only; ``record`` (a list) receives each change's inputs and
-    final output positions (for step-halving checks)."""
+    final output positions (for step-halving checks); ``freeze``: which still bodies a pruned
+    scene holds static (``mechc.sim.prune.build_scene``; default ``prune.FREEZE``)."""
     t0 = time.perf_counter()
     st = settings or DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
                                  if design.mechanism else 0.1)
@@ -94,7 +96,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         name = names[k]
         target = (vec >> (n - 1 - k)) & 1
         if prune:
-            run = run_case(design.netlist, mech, lib, types, st, state, name, float(target))
+            run = run_case(design.netlist, mech, lib, types, st, state, name, float(target),
+                           freeze=freeze)
             r = run.result
             sizes.append((run.cells, run.bodies, run.constraints))
             escalated += run.escalated
@@ -181,7 +184,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
         "steps": steps,
         "scene": _scene_json(scene, sizes),
-        "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order)),
+        "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order), freeze),
         "settings": st.to_json(),
         "seconds": round(time.perf_counter() - t0, 4),
     }
@@ -197,11 +200,11 @@ def _scene_json(scene: Scene | None, sizes: list[tuple[int, int, int]]) -> dict:
 
 
 def _pruning_json(why_not: str | None, sizes: list[tuple[int, int, int]], escalated: int,
-                  max_watch: float, cells: int) -> dict:
+                  max_watch: float, cells: int, freeze: str | None = None) -> dict:
     if why_not is not None:
         return {"enabled": False, "reason": why_not}
     a = np.array(sizes, dtype=float).reshape(-1, 3)
-    return {"enabled": True, "circuit_cells": cells,
+    return {"enabled": True, "circuit_cells": cells, "freeze": freeze or FREEZE,
             "mean_cells": round(float(a[:, 0].mean()), 3) if len(a) else 0.0,
             "mean_dynamic_bodies": round(float(a[:, 1].mean()), 3) if len(a) else 0.0,
             "mean_constraints": round(float(a[:, 2].mean()), 3) if len(a) else 0.0,

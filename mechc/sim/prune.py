@@ -7,23 +7,32 @@ dynamic scene then holds:
 - **cells** — the fan-in cone of the observed outputs, restricted to cells with an input that
   moves, the walk not passing an AMPLIFIER's inputs (an amplifier's powered output isolates
   what it drives from what drives it; :func:`cone`, on the netlist alone);
-- **the load** — every kept cell is kept *whole*, so a moving net still pushes every spring,
-  guide and contact of every cell it reaches (an AND whose other input holds its bar still
-  loads the moving input through its hook), whether or not that cell's output moves;
+- **the load** — every kept cell is kept *whole* (its still bodies static, below), so a moving
+  net still pushes every spring, guide and contact of every cell it reaches (an AND whose
+  other input holds its bar still loads the moving input through its hook), whether or not
+  that cell's output moves;
 - **boundary** — bodies outside the cone that the scene's rods hang on are placed at their
   closed-form pose (``Scene``'s kinematic boundary bodies); when their pose does not change
-  over the case they are static, not driven step by step. Optionally (``HOLD``, off: measured,
-  it saves ~20 % and triples the largest joint stretch) the input sliders of kept cells whose
-  input does not move, and the idle primary inputs, are made static too.
+  over the case they are static, not driven step by step.
+- **still bodies** (``FREEZE``) — bodies of kept cells (and idle primary inputs) that the
+  closed form keeps still over the change are made static at their closed-form pose; the
+  constraints between two static bodies go. Every constraint on a moving body stays, so a
+  moving net still meets every hook, stop and spring it meets in the whole scene, as a rigid
+  one. By default (``"inner"``) the kept cells' output terminals stay free, so a dwelling output
+  that the moving parts push still shows (as a glitch, or as a watched cut that does not
+  hold); ``"all"`` freezes those too (faster, blind to such pushes); ``"none"`` keeps every
+  kept body free (the cell-level cone alone).
 
 What pruning assumes, and how the run checks it: a kept cell whose output the closed form
 keeps still (it *dwells*) but that drives cells outside the scene must really stay still —
 otherwise a dynamic glitch would travel on into cells that were cut away. Those outputs are
 watched during the move (:data:`WATCH_PREFIX` pseudo-outputs); if one leaves ``watch_limit``
 (fraction of stroke) the case is run again on the whole mechanism (counted as ``escalated``).
-Un-moving upstream cells are held exactly at their closed-form positions: whether their springs
-really hold against the kept cells' loads is the static force-budget check's job (spring
-margin, DESIGN §7), which runs in every proof.
+Un-moving upstream cells and still bodies are held exactly at their closed-form positions:
+whether their springs really hold against the kept cells' loads is the static force-budget
+check's job (spring margin, DESIGN §7), which runs in every proof. A static body is stiffer than
+a sprung one: the largest joint stretch of a frozen scene came out larger than the whole
+scene's on every benchmark circuit (docs/performance.md), so the stretch limit is not eased.
 """
 
 from __future__ import annotations
@@ -37,7 +46,7 @@ import pymunk
 
 from mechc.library import Library
 from mechc.mech.assemble import Mechanism
-from mechc.mech.dynamics import DynSettings, MoveResult, Scene
+from mechc.mech.dynamics import MOVE_SAMPLES, DynSettings, MoveResult, Scene
 from mechc.mech.evaluate import evaluate, output_signals
 from mechc.mech.kinematics import Poses
 from mechc.netlist.ir import Netlist
@@ -45,9 +54,10 @@ from mechc.netlist.ir import Netlist
 CUT_TYPES = frozenset({"AMPLIFIER"})
 STATEFUL_TYPES = frozenset({"MEMORY"})  # at rest their output depends on history
 WATCH_PREFIX = "__watch:"
-SAMPLES = 41  # points along the moving input, as Scene.move samples its reference
+SAMPLES = MOVE_SAMPLES  # points along the moving input, as Scene.move samples its reference
 WATCH_LIMIT = 0.005  # fraction of stroke a watched (dwelling) cut output may move
-HOLD = False  # measured: holding them saves ~20 % but triples the joint stretch
+FREEZE_MODES = ("none", "inner", "all")
+FREEZE = "inner"  # bodies the closed form keeps still are static (see build_scene)
 MOVE_EPS = 1e-6  # mm (sliders) or mm at the body's reach (levers): "does not move"
 
 
@@ -95,6 +105,7 @@ class CasePlan:
     watch: dict[str, tuple[str, str]] = field(default_factory=dict)  # pseudo-output -> pin
     end_outputs: dict[str, float] = field(default_factory=dict)  # closed form after the change
     static: set[str] = field(default_factory=set)  # scene bodies made static
+    poses: Poses | None = None  # closed form along the change (SAMPLES), handed to the scene
 
 
 def _body_moves(poses: Poses, mech: Mechanism) -> set[str]:
@@ -102,6 +113,9 @@ def _body_moves(poses: Poses, mech: Mechanism) -> set[str]:
     out = set()
     for bid, u in poses.u.items():
         if np.ptp(np.nan_to_num(u)) > MOVE_EPS:
+            out.add(bid)
+    for bid, (dx, dy) in poses.xy.items():  # links translate as well as turn
+        if max(np.ptp(np.nan_to_num(dx)), np.ptp(np.nan_to_num(dy))) > MOVE_EPS:
             out.add(bid)
     for bid, th in poses.theta.items():
         b = index.get(bid)
@@ -138,7 +152,7 @@ def plan_case(nl: Netlist, mech: Mechanism, lib: Library, types: dict[str, str],
             if loads_out and net not in moving_nets:
                 watch[f"{WATCH_PREFIX}{c}.{pin}"] = (c, pin)
     end = {o: float(v[-1]) for o, v in output_signals(mech, poses).items()}
-    return CasePlan(name, order, moving, moving_nets, watch, end)
+    return CasePlan(name, order, moving, moving_nets, watch, end, poses=poses)
 
 
 def _terminal_body(mech: Mechanism, node: str, pin: str) -> str | None:
@@ -150,35 +164,32 @@ def _terminal_body(mech: Mechanism, node: str, pin: str) -> str | None:
 
 def build_scene(plan: CasePlan, nl: Netlist, mech: Mechanism, lib: Library,
                 types: dict[str, str], settings: DynSettings, state: dict[str, float],
-                hold: bool | None = None) -> Scene:
-    """The pruned scene of ``plan``, at rest in the input state ``state``; ``hold``: also
-    make static the input sliders that only a static driver holds."""
+                freeze: str | None = None) -> Scene:
+    """The pruned scene of ``plan``, at rest in the input state ``state``. ``freeze`` (default
+    :data:`FREEZE`): which bodies the closed form keeps still are made static — ``"none"``,
+    ``"inner"`` (all but the kept cells' output terminals, which stay free so a pushed output
+    still shows as a glitch or a cut that does not hold) or ``"all"``."""
     view = dataclasses.replace(mech, outputs={**mech.outputs, **plan.watch})
-    sc = Scene.build(view, lib, types, settings, dict(state), plan.cells)
+    sc = Scene.build(view, lib, types, settings, dict(state), plan.cells, poses=plan.poses)
     static: set[str] = set()
     # boundary bodies the closed form keeps still: static, not driven every step
     for bid in list(sc.boundary):
         if bid not in plan.moving_bodies:
             sc.boundary.discard(bid)
             static.add(bid)
-    # idle primary inputs, and input sliders of kept cells whose input does not move
+    mode = FREEZE if freeze is None else freeze
+    if mode not in FREEZE_MODES:
+        raise ValueError(f"freeze must be one of {FREEZE_MODES}, not {mode!r}")
     held: set[str] = set()
-    for name, part in mech.inputs.items():
-        if name != plan.name:
-            held.add(part.terminals[name].body)
-    for c in plan.cells:
-        cls = lib[types[c]]
-        cell = nl.cells[c]
-        for pin, net in zip(cls.input_names(len(cell.inputs)), cell.inputs):
-            t = mech.cells[c].terminals.get(pin)
-            if t is not None and net not in plan.moving_nets:
-                held.add(t.body)
-    held -= plan.moving_bodies
-    if not (HOLD if hold is None else hold):
-        held = set()
+    if mode != "none":
+        held = set(sc.bodies) - plan.moving_bodies
+        if mode == "inner":
+            for c in plan.cells:
+                for net in nl.cells[c].outputs:
+                    held.discard(mech.cells[c].terminals[nl.driver[net][1]].body)
     for bid in held:
-        b = sc.bodies.get(bid)
-        if b is None or b.body_type != pymunk.Body.DYNAMIC:
+        b = sc.bodies[bid]
+        if b.body_type != pymunk.Body.DYNAMIC:
             continue
         b.body_type = pymunk.Body.KINEMATIC
         b.velocity = (0.0, 0.0)
@@ -214,12 +225,12 @@ def scene_size(sc: Scene) -> tuple[int, int]:
 
 def run_case(nl: Netlist, mech: Mechanism, lib: Library, types: dict[str, str],
              settings: DynSettings, state: dict[str, float], name: str, target: float,
-             watch_limit: float = WATCH_LIMIT) -> CaseRun:
+             watch_limit: float = WATCH_LIMIT, freeze: str | None = None) -> CaseRun:
     """Move input ``name`` from ``state`` to ``target`` on the pruned scene; outputs outside
     it are reported at their closed-form position (they do not move in this change)."""
     plan = plan_case(nl, mech, lib, types, state, name, target)
-    sc = build_scene(plan, nl, mech, lib, types, settings, state)
-    r = sc.move(name, target)
+    sc = build_scene(plan, nl, mech, lib, types, settings, state, freeze)
+    r = sc.move(name, target, reference=plan.poses)
     dev = 0.0
     for key in plan.watch:
         if key in r.outputs and key in r.reference:
@@ -227,8 +238,8 @@ def run_case(nl: Netlist, mech: Mechanism, lib: Library, types: dict[str, str],
             dev = max(dev, float(np.max(np.where(np.isfinite(d), d, np.inf))))
     escalated = not dev <= watch_limit
     if escalated:  # the cut did not hold: run the change on the whole mechanism
-        sc = Scene.build(mech, lib, types, settings, dict(state))
-        r = sc.move(name, target)
+        sc = Scene.build(mech, lib, types, settings, dict(state), poses=plan.poses)
+        r = sc.move(name, target, reference=plan.poses)
     for d in (r.outputs, r.reference, r.final):
         for key in [k for k in d if k.startswith(WATCH_PREFIX)]:
             del d[key]
