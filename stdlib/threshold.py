@@ -38,7 +38,8 @@ from mechc.threshold.generator import GeneratorDesign, design_generator
 ROD_FACTOR = 1.5  # shortest input rod, in crank lengths (keeps the rod-crank angle >= 70 deg)
 PRESSURE_LIMIT_DEG = 30.0
 MU_MIN_DEG = 45.01  # the separator meets mu_min exactly in the Fig. 42 position: keep 0.01 deg
-PROFILE_POINTS = 720  # cam polyline vertices for the dynamic model and the drawing
+PROFILE_POINTS = 720  # cam outline vertices (0.5 deg apart) for the drawing and the contact
+TOUCH_SLACK_DEG = 3.0  # contact arc beyond the cam angles the roller can reach
 CAM_RANGE_TOL = np.radians(4.9)  # the closed cam dwells 5 deg beyond its working range
 CAM_FRICTION = 0.05  # coefficient between cam and roller (a rolling roller: small)
 
@@ -205,7 +206,7 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
         b.part.joints.append(Joint(b._id("pin"), "pin", a, bb, pa=P(p)))
 
     far_f = J["F"] if np.dot(J["F"] - J["A"], J["D"] - J["A"]) > np.dot(
-        J["D"] - J["A"], J["D"] - J["A"]) else J["D"]
+        J["D"] - J["A"], J["D"] - J["A"]) or lay.f_offset else J["D"]
     ad = link("AD", [J["A"], J["D"], far_f] if far_f is not J["D"] else [J["A"], J["D"]], 5,
               "separator link AD (carries F)")
     de = link("DE", [J["D"], J["E"]], 6, "separator coupler DE")
@@ -231,8 +232,16 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
     phi_d = float(ks.cam_angle[0])
     ang = float(d.cam_body_angle(phi_d))
     rot = np.array([[math.cos(ang), -math.sin(ang)], [math.sin(ang), math.cos(ang)]])
-    prof = d.cam_profile[:: max(1, len(d.cam_profile) // PROFILE_POINTS)]
-    prof_w = [P(K + rot @ p) for p in prof]
+    step = max(1, len(d.cam_profile) // PROFILE_POINTS)
+    prof_w = [P(K + rot @ p) for p in d.cam_profile[::step]]
+    # the contact: only the arc the roller can reach (the working range, the 5 deg dwells the
+    # generator adds beyond it, and TOUCH_SLACK_DEG more), at the outline's resolution -- the
+    # dynamic model checks every segment of it at every step
+    per_rad = len(d.cam_profile) / (2 * np.pi)  # profile index 0 is at cam angle lo - 5 deg
+    slack = np.radians(TOUCH_SLACK_DEG)
+    reach = d.cam_range[1] - d.cam_range[0] + 2 * np.radians(5.0)
+    idx = np.arange(-int(slack * per_rad), int((reach + slack) * per_rad) + 1, step)
+    touch_w = [P(K + rot @ p) for p in d.cam_profile[idx % len(d.cam_profile)]]
     cam = b.name("cam")
     cam_polys = [prof_w, bar_poly(P(K), P(J["J"]), w)]
     b.part.bodies.append(Body(cam, "lever", cam_polys, ctx.mass(cam_polys), pivot=P(K),
@@ -254,7 +263,7 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
     f_polys = [bar_poly(P(Z), P(H), w * 0.6), bar_poly(P(Z), P(Q), w)]
     b.part.bodies.append(Body(follower, "lever", f_polys, ctx.mass(f_polys), pivot=P(Z),
                               layer=11, role="output crank with roller"))
-    touch = Joint(b._id("touch"), "touch", cam, follower, q=P(H), profile=prof_w + [prof_w[0]],
+    touch = Joint(b._id("touch"), "touch", cam, follower, q=P(H), profile=touch_w,
                   length=fol.roller * sc, friction=CAM_FRICTION)
     b.part.joints.append(touch)
     y_q = P(Z)[1] + l_mm * math.cos(delta)
@@ -277,8 +286,13 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
     r = d.realisation
     b.part.data["threshold"] = {
         "fv": d.fv, "truth_table": list(d.truth_table),
-        "mechanism_weights": list(r.weights), "mechanism_thresholds": list(r.thresholds),
-        "mechanism_below": int(r.below),
+        "mechanism": "planar" if d.planar else "threshold",
+        "mechanism_weights": None if d.planar else list(r.weights),
+        "mechanism_thresholds": None if d.planar else list(r.thresholds),
+        "mechanism_below": None if d.planar else int(r.below),
+        "planar": None if not d.planar else {
+            "wiring_function": list(d.planar.h), "p1": d.planar.p1, "p2": d.planar.p2,
+            "f_offset": d.planar.offset, "separation_deg": d.planar.separation_deg},
         "cam_body": cam, "follower_body": follower, "output_body": out.body,
         "touch_joint": touch.id,
         "phi_design": phi_d, "orientation": int(loop.orientation),

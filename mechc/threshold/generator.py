@@ -22,12 +22,26 @@ from mechc.threshold.cam import (
     curvature_radius,
     profile,
 )
-from mechc.threshold.functions import as_truth_table, function_value, input_matrix, n_inputs
+from mechc.threshold.functions import (
+    as_truth_table,
+    function_value,
+    input_matrix,
+    n_inputs,
+    npn_canonical,
+)
 from mechc.threshold.linkage import (
     ThresholdLoop,
     basic_loop,
     sample_points,
     threshold_gaps,
+)
+from mechc.threshold.planar import (
+    PlanarGenerator,
+    held_sets,
+    move_samples,
+    planar_generator,
+    runs,
+    wiring_for,
 )
 from mechc.threshold.separator import SeparatorLayout, analyse, layout
 from mechc.threshold.weights import Realisation, realise, static_hazards
@@ -105,6 +119,7 @@ class GeneratorDesign:
     threshold_gaps_deg: tuple[float, ...] = ()
     checks: list[DesignCheck] = field(default_factory=list)
     hazards: list[tuple[int, int]] = field(default_factory=list)
+    planar: PlanarGenerator | None = None  # set when F moves in two dimensions (no hazards)
 
     @property
     def ok(self) -> bool:
@@ -186,6 +201,11 @@ def design_generator(f: Sequence[int] | int, stroke_mm: float = 20.0, n: int = 3
         design.kind = "literal"
         design.literal = (j, tt[(1 << (n - 1 - j))] == 0)  # value with only input j on
         return design
+    if design.hazards:
+        # no threshold generator holds every output: F must move in two dimensions
+        pg = planar_generator(npn_canonical(tt), mu_min_deg, samples)
+        if pg is not None:
+            return _design_planar(design, pg, mu_min_deg, pressure_limit_deg, samples, strict)
 
     mags = tuple(sorted((abs(r.weights[j]) for j in active), reverse=True))
     lay = layout(mags, mu_min_deg)
@@ -205,8 +225,6 @@ def design_generator(f: Sequence[int] | int, stroke_mm: float = 20.0, n: int = 3
     an = analyse(lay, samples)
     sp = sample_points(an)
     phi = loop.cam_angle(sp.F)
-    lo_w, hi_w = float(phi.min()), float(phi.max())
-    design.cam_range = (lo_w, hi_w)
     room = threshold_gaps(phi, sp, gaps)
     design.threshold_gaps_deg = tuple(float(np.degrees(g)) for g in room)
     bands = []
@@ -215,9 +233,66 @@ def design_generator(f: Sequence[int] | int, stroke_mm: float = 20.0, n: int = 3
         high = phi[sp.lo >= g + 1].min()
         c = DWELL_CLEARANCE * (high - low)
         bands.append((float(low + c), float(high - c)))
-    program = FollowerProgram(tuple(bands))
+    checks = [
+        DesignCheck("separator transmission angle", an.min_transmission,
+                    mu_min_deg - TRANSMISSION_TOL, "deg", "min"),
+        DesignCheck("loop FJK transmission angle", float(loop.transmission(sp.F).min()),
+                    mu_min_deg, "deg", "min"),
+        DesignCheck("threshold gap", float(np.degrees(room.min())), 0.0, "deg", "min"),
+        DesignCheck("F gap between adjacent levels", an.min_gap * scale, 0.0, "mm", "min"),
+        DesignCheck("separator structural error", float(np.abs(an.structural_error).max()
+                                                        / an.unit), 0.5, "level", "max"),
+    ]
+    return _finish(design, phi, tuple(bands), r.below == 1, checks, pressure_limit_deg, strict)
+
+
+def _design_planar(design: GeneratorDesign, pg: PlanarGenerator, mu_min_deg: float,
+                   pressure_limit_deg: float, samples: int, strict: bool) -> GeneratorDesign:
+    """A generator whose F moves in two dimensions (:mod:`mechc.threshold.planar`): the wiring
+    makes this function read as the class design's ``h``; the cam holds every held set."""
+    perm, neg, inverted = wiring_for(design.truth_table, pg.h)
+    design.planar = pg
+    lay = pg.layout(mu_min_deg)
+    design.separator = lay
+    design.scale = design.stroke_mm / lay.s_i
+    for j in range(3):
+        c = lay.cranks[perm[j]]
+        design.crank_of_input[j] = c
+        design.primed[c] = bool(neg[j])
+    design.loop = pg.loop
+    ms = move_samples(lay, samples)
+    F = ms.F
+    phi = pg.loop.cam_angle(F)
+    sets = held_sets(pg.h, ms)
+    rr = runs(phi, sets)  # raises if held sets of outputs 0 and 1 overlap
+    bands, gaps = [], []
+    for (_, hi, _), (lo, _, _) in zip(rr, rr[1:]):
+        c = DWELL_CLEARANCE * (lo - hi)
+        bands.append((hi + c, lo - c))
+        gaps.append(float(np.degrees(lo - hi)))
+    design.threshold_gaps_deg = tuple(gaps)
+    design.hazards = []  # held outputs stay on their dwells: the mechanism has none
+    checks = [
+        DesignCheck("separator transmission angle", ms.min_transmission,
+                    mu_min_deg - TRANSMISSION_TOL, "deg", "min"),
+        DesignCheck("loop FJK transmission angle", float(pg.loop.transmission(F).min()),
+                    mu_min_deg, "deg", "min"),
+        DesignCheck("threshold gap", min(gaps), 0.0, "deg", "min"),
+    ]
+    primed_out = (rr[0][2] ^ int(inverted)) == 1
+    return _finish(design, phi, tuple(bands), primed_out, checks, pressure_limit_deg, strict)
+
+
+def _finish(design: GeneratorDesign, phi: np.ndarray, bands: tuple[tuple[float, float], ...],
+            primed_out: bool, checks: list[DesignCheck], pressure_limit_deg: float,
+            strict: bool) -> GeneratorDesign:
+    """Follower program, follower, closed cam and the remaining checks, from the cam angles
+    ``phi`` (rad) F reaches at rest and on every change and the transition bands."""
+    loop, lay, scale = design.loop, design.separator, design.scale
+    lo_w, hi_w = float(phi.min()), float(phi.max())
+    design.cam_range = (lo_w, hi_w)
+    program = FollowerProgram(bands)
     design.program = program
-    primed_out = r.below == 1
     # the pressure angle peaks inside the bands; dwells are sampled coarsely while sizing
     coarse = np.concatenate([np.linspace(lo_w, hi_w, 101)]
                             + [np.linspace(a, b, 201) for a, b in bands])
@@ -240,16 +315,8 @@ def design_generator(f: Sequence[int] | int, stroke_mm: float = 20.0, n: int = 3
     design.cam_pitch = pitch * scale
     design.cam_profile = profile(pitch, fol.roller) * scale
 
-    trans_loop = float(loop.transmission(sp.F).min())
-    design.checks = [
-        DesignCheck("separator transmission angle", an.min_transmission,
-                    mu_min_deg - TRANSMISSION_TOL, "deg", "min"),
-        DesignCheck("loop FJK transmission angle", trans_loop, mu_min_deg, "deg", "min"),
-        DesignCheck("cam pressure angle", pa, pressure_limit_deg, "deg", "max"),
-        DesignCheck("threshold gap", float(np.degrees(room.min())), 0.0, "deg", "min"),
-        DesignCheck("F gap between adjacent levels", an.min_gap * scale, 0.0, "mm", "min"),
-        DesignCheck("separator structural error", float(np.abs(an.structural_error).max()
-                                                        / an.unit), 0.5, "level", "max"),
+    design.checks = checks[:2] + [
+        DesignCheck("cam pressure angle", pa, pressure_limit_deg, "deg", "max")] + checks[2:] + [
         DesignCheck("pitch curve convex radius / roller radius", convex_min / fol.roller, 1.0,
                     "", "min"),
         DesignCheck("shortest loop link / l", min(loop.FJ, loop.JK), 1.0 / 3.0 - 1e-9, "",

@@ -125,6 +125,9 @@ class SeparatorLayout:
     centres: dict[str, tuple[tuple[float, float], tuple[float, float]]]  # crank: (X, X')
     tilts: dict[str, float]  # coupler droop angles (rad)
     branches: dict[str, int] = field(default_factory=dict)
+    #: F's distance from the line AD, as a fraction of AD, to the left of A -> D (0: F on the
+    #: line, as in every threshold generator; see mechc.threshold.planar for the others)
+    f_offset: float = 0.0
 
     @property
     def cranks(self) -> tuple[str, ...]:
@@ -160,6 +163,8 @@ class SeparatorLayout:
             out.update(C=C, G=G)
         D = circle_intersection(A, L["AD"], E, L["DE"], self.branches["D"], "loop ADE")
         F = A + (L["AF"] / L["AD"]) * (D - A)
+        if self.f_offset:
+            F = F + self.f_offset * np.stack([A[..., 1] - D[..., 1], D[..., 0] - A[..., 0]], -1)
         out.update(D=D, E=E, F=F)
         return out
 
@@ -181,10 +186,12 @@ class SeparatorLayout:
 
 
 def layout(magnitudes: tuple[int, ...], mu_min_deg: float = 45.0,
-           proportions: Proportions | None = None, tilt_rule: str = "table_v") -> SeparatorLayout:
+           proportions: Proportions | None = None, tilt_rule: str = "table_v",
+           f_offset: float = 0.0) -> SeparatorLayout:
     """Dimension a separator. ``tilt_rule`` "mirror" droops every coupler by :func:`droop` of the
     vertical link it meets; "table_v" uses the droop of a unit link for every coupler except DE
-    when AD != l, which is horizontal as printed in Table V column V."""
+    when AD != l, which is horizontal as printed in Table V column V. ``f_offset`` moves F off
+    the line AD (see :attr:`SeparatorLayout.f_offset`)."""
     p = proportions or proportion(magnitudes)
     s_i, alpha = input_stroke(mu_min_deg)
     delta = float(np.arcsin(s_i / 2))
@@ -228,7 +235,7 @@ def layout(magnitudes: tuple[int, ...], mu_min_deg: float = 45.0,
     branches = {"D": branch_of(joints0["A"], joints0["E"], joints0["D"])}
     if p.p2 is not None:
         branches["G"] = branch_of(joints0["B"], joints0["C"], joints0["G"])
-    return SeparatorLayout(p, s_i, delta, lengths, centres, tilts, branches)
+    return SeparatorLayout(p, s_i, delta, lengths, centres, tilts, branches, float(f_offset))
 
 
 # --- analysis ----------------------------------------------------------------------------------
