@@ -182,6 +182,11 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
                    help="rated force of each input actuator (default: %(default)s N)")
     m.add_argument("--output-load", type=float, default=0.5, metavar="N",
                    help="force each circuit output must move either way (default: %(default)s N)")
+    m.add_argument("--no-amplify", action="store_true",
+                   help="never insert AMPLIFIER cells by itself (by default they go where an "
+                   "actuator or a MEMORY loop is short of force, and before a sequential output "
+                   "that would move partway while a memory switches); the design checks then "
+                   "report what fails")
 
 
 def _options(args):
@@ -207,6 +212,7 @@ def _options(args):
         mech=MechOptions(stroke=args.stroke, actuator_force=args.actuator_force,
                          output_load=args.output_load),
         cell_dirs=tuple(args.cell_dirs),
+        amplify=not getattr(args, "no_amplify", False),
         timings=getattr(args, "timings", False),
     )
 
@@ -269,6 +275,8 @@ def cmd_compile(args) -> int:
         for h in se.essential_hazards:
             print(f"  essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
                   f"{h['to']}: {h['requires']}")
+    for net, why in st.get("amplified", {}).items():
+        print(f"  AMPLIFIER on {net}: {why}")
     if args.print_netlist:
         print(design.netlist.to_text(), end="")
     dc = st.get("design_checks", {})

@@ -27,6 +27,7 @@ class CompileOptions:
     map: MapOptions = field(default_factory=MapOptions)
     mech: MechOptions = field(default_factory=MechOptions)
     cell_dirs: tuple[str, ...] = ()
+    amplify: bool = True  # insert AMPLIFIERs where forces fail or an output must snap
     timings: bool = False  # record seconds per stage in the JSON (makes output non-reproducible)
 
 
@@ -66,10 +67,13 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
     eq = stage("minimise", minimise, spec, opts.minimise)
     mapped = stage("map", map_equations, eq, lib, opts.map)
     layout = stage("place", place, mapped.netlist)
-    mech = stage("synthesise", synthesise_mechanism, mapped.netlist, layout, lib, opts.mech)
-    stats = design_stats(eq, mapped.netlist, lib, layout)
+    nl, layout, mech, amps = stage("synthesise", synthesise_powered, mapped.netlist, lib, opts,
+                                   layout)
+    stats = design_stats(eq, nl, lib, layout)
+    if amps:
+        stats["amplified"] = amps
     design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
-                    mapped.netlist, layout, stats, seconds, eq, mech)
+                    nl, layout, stats, seconds, eq, mech)
     stage("check", run_design_checks, design, lib)
     return design
 
@@ -125,21 +129,62 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
             return se, mapped
 
         se, mapped = stage("polarity", cheapest, se, mapped)
-    layout = stage("place", place, mapped.netlist)
+    nl, amps = mapped.netlist, {}
+    if opts.amplify:
+        from mechc.netlist.amplify import snap_outputs
+        from mechc.sim.sequential import outputs_needing_snap
+
+        snaps = stage("snap", outputs_needing_snap, nl, spec)
+        if snaps:
+            nl = snap_outputs(nl, lib, sorted(snaps))
+            amps = {o: f"snap: must hold at {w}, but a MEMORY switches before the input "
+                       "ends its stroke" for o, w in snaps.items()}
+    layout = stage("place", place, nl)
     equations = {o: se.text(o) for o in spec.outputs}
     for m in se.memories:
         equations[se.set_names[m]] = se.text(se.set_names[m])
         equations[se.reset_names[m]] = se.text(se.reset_names[m])
-    stats = design_stats(se.eq, mapped.netlist, lib, layout)
-    stats["sequential"] = {"memories": len(se.memories), **se.checked}
     mech = None
     if mechanism:
-        mech = stage("synthesise", synthesise_mechanism, mapped.netlist, layout, lib, opts.mech)
-    design = Design(spec, equations, mapped.implemented, mapped.netlist, layout, stats, seconds,
+        nl, layout, mech, more = stage("synthesise", synthesise_powered, nl, lib, opts, layout)
+        amps.update(more)
+    stats = design_stats(se.eq, nl, lib, layout)
+    stats["sequential"] = {"memories": len(se.memories), **se.checked}
+    if amps:
+        stats["amplified"] = amps
+    design = Design(spec, equations, mapped.implemented, nl, layout, stats, seconds,
                     se.eq, mech, se)
     if mechanism:
         stage("check", run_design_checks, design, lib)
     return design
+
+
+#: Rounds of "synthesise, amplify the nets whose forces fail" before giving up.
+MAX_AMPLIFY_ROUNDS = 3
+
+
+def synthesise_powered(nl: Netlist, lib: Library, opts: CompileOptions,
+                       layout: Layout | None = None
+                       ) -> tuple[Netlist, Layout, Mechanism, dict[str, str]]:
+    """Place and synthesise; where the force budget fails (an input actuator overloaded, a
+    MEMORY loop whose demand grows every time round), put those nets' loads behind AMPLIFIERs
+    and synthesise again. Returns the (possibly amplified) netlist, its layout and mechanism,
+    and net -> reason for every net amplified."""
+    from mechc.netlist.amplify import amplify_nets, nets_short_of_force
+
+    amps: dict[str, str] = {}
+    for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
+        if layout is None or attempt:
+            layout = place(nl)
+        mech = synthesise_mechanism(nl, layout, lib, opts.mech)
+        if not opts.amplify or attempt == MAX_AMPLIFY_ROUNDS:
+            break
+        short = nets_short_of_force(nl, mech, lib)
+        if not short:
+            break
+        amps.update(short)
+        nl = amplify_nets(nl, lib, short)
+    return nl, layout, mech, amps
 
 
 def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = None,
@@ -171,6 +216,8 @@ def run_design_checks(design: Design, lib: Library) -> None:
     budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
     sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
     measured = stats.checks()
+    if design.sequential is not None:
+        measured += _memory_checks(design, lib, stats)
     mech.checks = mech.synthesis_checks() + measured
     failed = [c for c in mech.checks if not c.passed]
     mus = [c.value for c in mech.checks if c.name == "transmission angle"]
@@ -178,6 +225,22 @@ def run_design_checks(design: Design, lib: Library) -> None:
         "passed": not failed, "count": len(mech.checks), "failed": [c.text() for c in failed],
         "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
     }
+
+
+def _memory_checks(design: Design, lib: Library, stats) -> list:
+    """A sequential design is also walked through every specified transition (the kinematic
+    sequential proof): each MEMORY's SET and RESET must never press its lever together."""
+    from mechc.mech.model import Check
+    from mechc.sim.seqmech import prove_sequential_kinematic
+
+    r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)
+    per_cell: dict[str, int] = {}
+    for f in r["failures"]:
+        if f["kind"] == "S·R overlap":
+            per_cell[f["cell"]] = per_cell.get(f["cell"], 0) + 1
+    mems = [c.id for c in design.netlist.cells.values() if c.type == "MEMORY"]
+    return [Check("SET and RESET apart (transitions where both press)", f"MEMORY {c}",
+                  float(per_cell.get(c, 0)), 0.0, "<=") for c in mems]
 
 
 def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None) -> dict:

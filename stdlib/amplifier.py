@@ -155,6 +155,12 @@ class Amplifier(Cell):
     max_inputs = 1
     description = ("powered friction rollers switch a bistable toggle: input force ~ slider "
                    "friction (Fig. 17)")
+    # loads one amplifier drives in a mapped design: 3 OR inputs pass the measurement above,
+    # but in the four-state table of tests/sequential an amplifier with an OR, a 3-input AND
+    # and an AND on its output stalled before its toggle's dead point (dynamic proof: S·R
+    # overlap downstream); 2 loads of any kind switched. A force-based rule would be better.
+    fanout_max = 2
+    switching_delay_s = MEASURED["switching_delay_s"]
 
     @classmethod
     def cost(cls, n_inputs: int) -> int:

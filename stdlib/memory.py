@@ -114,6 +114,10 @@ class Memory(Cell):
         push_r = ctx.margin * (arm_force + (demand.left + ctx.friction) * rq / a)
         return b.finish({"S": Demand(push_s, 0.0), "R": Demand(push_r, 0.0)})
 
+    @classmethod
+    def build_dynamics(cls, scene, part) -> None:
+        _stiff_stops(scene, part)
+
     @staticmethod
     def torque(phi: np.ndarray, k: float, rest: float, d: dict) -> np.ndarray:
         """Detent torque (N mm) pushing the lever away from upright at throw ``phi``."""
@@ -157,7 +161,9 @@ class Memory(Cell):
         sin_phi = np.where(on & ~reset, np.minimum(sin_phi, sig_r), sin_phi)
         new = np.where(set_, 1.0, np.where(reset, 0.0, state))
         sin_phi = np.where(set_ & ~reset, sin_a, np.where(reset & ~set_, -sin_a, sin_phi))
-        jam = (set_ & reset) | (sig_s > sin_a + 1e-9) | (sig_r < -sin_a - 1e-9)
+        # the faces bind the lever when S asks for more throw than R allows (both pressing,
+        # from either side); beyond a stop the input itself is blocked
+        jam = (sig_s > sig_r + 1e-9) | (sig_s > sin_a + 1e-9) | (sig_r < -sin_a - 1e-9)
         phi = np.arcsin(np.clip(sin_phi, -1, 1))
         poses = Poses()
         poses.u[s_body], poses.u[r_body] = np.array(us, float), np.array(ur, float)
@@ -169,6 +175,21 @@ class Memory(Cell):
         poses.mark(q_body, jam)
         poses.state[lever.id.rsplit(".", 1)[0]] = new
         return poses
+
+
+#: pymunk: fraction of a joint error left after 1 s, for the lever's stops and their touches.
+STOP_ERROR_BIAS = 0.1 ** 60
+
+
+def _stiff_stops(scene, part) -> None:
+    """The lever lands on a stop at speed when the detent throws it: correct the overrun
+    within milliseconds, not pymunk's default 1/6 s (a slow creep back off the stop reads as
+    an output that has not settled, or one past its end)."""
+    lever = next(bd.id for bd in part.bodies if bd.kind == "lever")
+    lb = scene.bodies[lever]
+    for c in scene.space.constraints:
+        if lb in (c.a, c.b):
+            c.error_bias = STOP_ERROR_BIAS
 
 
 def _stop(b: Builder, lever: str, at, point, nx: float) -> Joint:

@@ -37,6 +37,8 @@ def eval_json(design: dict, inputs: dict[str, np.ndarray]) -> dict[str, np.ndarr
                 v = ~reduce(np.logical_or, x)
             elif t == "NOT":
                 v = ~x[0]
+            elif t == "AMPLIFIER":  # a powered buffer, put in where an actuator is short
+                v = x[0]
             elif t == "AND_NOT":
                 v = x[0] & ~x[1]
             elif t == "OR_NOT":

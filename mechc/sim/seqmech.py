@@ -134,6 +134,59 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
             "seconds": round(time.perf_counter() - t0, 3)}
 
 
+#: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
+MEMORY_THROW_S = 0.03
+
+
+def settle_allowance(design: Design, lib: Library) -> float:
+    """How long after an input's move a sequential circuit may still be switching: along the
+    slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
+    transition may pass through every memory in turn. Used as the hold of each change, so a
+    circuit that is slow by design is not reported unsettled (it still must settle)."""
+    import networkx as nx
+
+    nl = design.netlist
+    g = nl.combinational_graph()
+    delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
+             for c in nl.cells.values()}
+    longest: dict[str, float] = {}
+    for node in nx.topological_sort(g):
+        here = max((longest[u] for u in g.predecessors(node)), default=0.0)
+        longest[node] = here + delay.get(node, 0.0)
+    path = max(longest.values(), default=0.0)
+    m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
+    return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
+
+
+def _memory_inputs(mech, lib, types, scene) -> dict[str, tuple[str, str]]:
+    """Stateful cell -> (S body, R body) for the cells present in the scene."""
+    out = {}
+    for cid, part in mech.cells.items():
+        if getattr(lib[types[cid]], "stateful", False) and "S" in part.terminals:
+            pair = (part.terminals["S"].body, part.terminals["R"].body)
+            if all(b in scene.bodies for b in pair):
+                out[cid] = pair
+    return out
+
+
+def _binding(mech, lib, types, watch, watched) -> list[str]:
+    """Stateful cells whose recorded S and R positions the closed form cannot accept (the
+    faces press the lever from both sides): an S·R overlap seen in the dynamics, e.g. one path
+    delayed by an AMPLIFIER (001 Appendix B.2)."""
+    bad = []
+    for cid, (s_body, r_body) in watch.items():
+        if s_body not in watched or r_body not in watched:
+            continue
+        us, ur = watched[s_body], watched[r_body]
+        part = mech.cells[cid]
+        poses = lib[types[cid]].kinematics(part, {s_body: us, r_body: ur}, len(us),
+                                           np.zeros(len(us)))
+        lever = [b.id for b in part.bodies if b.id in poses.bad]
+        if any(poses.bad[b].any() for b in lever):
+            bad.append(cid)
+    return bad
+
+
 def _last(outs: dict[str, np.ndarray]) -> dict[str, float]:
     return {o: float(np.ravel(v)[-1]) for o, v in outs.items()}
 
@@ -141,13 +194,17 @@ def _last(outs: dict[str, np.ndarray]) -> dict[str, float]:
 def prove_sequential_dynamic(design: Design, spec, lib: Library,
                              settings: DynSettings | None = None, tolerance: float = 0.05,
                              seed: int = 0, random_walks: int = 2,
-                             progress: Callable[[int, int], None] | None = None) -> dict:
-    """Drive the pymunk scene through the same sequences; a fresh scene per sequence starts
-    at power-up."""
+                             progress: Callable[[int, int], None] | None = None,
+                             sequences: list[list[dict[str, int]]] | None = None) -> dict:
+    """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
+    each from the power-up inputs); a fresh scene per sequence starts at power-up."""
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)
     st = settings or DynSettings(violation_limit=0.005 * mech.ctx.stroke)
-    walks = _walks(spec, seed, random_walks)
+    if settings is None:
+        st.settle_time = max(st.settle_time, settle_allowance(design, lib))
+    walks = (_walks(spec, seed, random_walks) if sequences is None
+             else [(s, expected_after(spec, s)) for s in sequences])
     total = sum(len(s) - 1 for s, _ in walks)
     fails = _Failures()
     _synthesis_failures(fails, design)
@@ -158,6 +215,8 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
     for si, (seq, want) in enumerate(walks):
         cur = {k: float(v) for k, v in seq[0].items()}
         scene = Scene.build(mech, lib, types, st, cur)
+        watch = _memory_inputs(mech, lib, types, scene)
+        scene.watch = [b for pair in watch.values() for b in pair]
         for k in range(1, len(seq)):
             moved = next(n for n in seq[k] if seq[k][n] != cur[n])
             r = scene.move(moved, float(seq[k][moved]))
@@ -169,6 +228,9 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
             if not r.max_violation <= st.violation_limit:
                 fails.add("solver", **where, message=f"solver error: joint {r.worst_joint} "
                           f"stretched {r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
+            for c in _binding(mech, lib, types, watch, r.watched):
+                fails.add("S·R overlap", **where, cell=c, message=f"MEMORY {c}: SET and RESET "
+                          "pressed the lever from both sides at once (binds)")
             if r.max_penetration > st.penetration_limit:
                 fails.add("contact", **where, message=f"a contact overrun by "
                           f"{r.max_penetration:.4g} mm (limit {st.penetration_limit} mm)")

@@ -292,6 +292,43 @@ def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> dict:
     return _report(spec, t0, failures, kinds, hazards, len(seen), transitions, m)
 
 
+def outputs_needing_snap(nl: Netlist, spec: SeqSpec) -> dict[str, str]:
+    """Outputs that must hold through some specified transition but whose generator moves
+    partway: steady while the input is mid-stroke with no memory moved (no static hazard), X
+    once the memories the change excites are free to switch (algorithm A). A memory toggles
+    before its input finishes the stroke, so such an output moves by the stroke the input had
+    left; an AMPLIFIER's bistable toggle (:mod:`mechc.netlist.amplify`) keeps it from the
+    output. Returns output -> one transition where it happens. Empty when the circuit does not
+    settle at power-up (the proof reports that)."""
+    sn = SeqNetlist(nl, spec.inputs)
+    x0, s0 = initial_total_state(spec)
+    st = settle_async(sn.excite(x0), sn.initial(), sn.m)
+    if st.overlaps or st.cycle or len(st.finals) != 1:
+        return {}
+    start = (x0, s0, st.finals[0])
+    seen, todo = {start}, deque([start])
+    found: dict[str, str] = {}
+    while todo:
+        x, s, q = todo.popleft()
+        before = output_values(spec, s, x)
+        for x2 in allowed_changes(spec, s, x):
+            s2 = next_stable(spec, s, x, x2)
+            after = output_values(spec, s2, x2)
+            t = ternary_transition(sn, x, x2, q)
+            for o in spec.outputs:
+                net = nl.outputs[o]
+                hold = before[o] is not None and before[o] == after[o]
+                if hold and o not in found and t["start"][net] != X and t["after_a"][net] == X:
+                    found[o] = f"{describe_total(spec, x, s)}, {_moved(spec, x, x2)}"
+            res = settle_async(sn.excite(x2), q, sn.m)
+            for qf in res.finals[:1]:
+                node = (x2, s2, qf)
+                if node not in seen:
+                    seen.add(node)
+                    todo.append(node)
+    return found
+
+
 def _moved(spec: SeqSpec, x: int, x2: int) -> str:
     k = (x ^ x2).bit_length()
     name = spec.inputs[spec.n - k]
