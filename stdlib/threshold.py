@@ -215,8 +215,9 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
     if lay.five_bar:
         pin(b.name("crank_B"), de, J["E"])
     else:
+        # E beyond G, or off the line BG (free eight-bar, mechc.threshold.planar): bent bar
         far_e = J["E"] if np.dot(J["E"] - J["B"], J["G"] - J["B"]) > np.dot(
-            J["G"] - J["B"], J["G"] - J["B"]) else J["G"]
+            J["G"] - J["B"], J["G"] - J["B"]) or lay.e_offset else J["G"]
         bg = link("BG", [J["B"], J["G"], far_e] if far_e is not J["G"] else [J["B"], J["G"]],
                   7, "separator link BG (carries E)")
         cg = link("CG", [J["C"], J["G"]], 8, "separator coupler CG")
@@ -308,6 +309,8 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
         "checks": [str(c) for c in d.checks],
         "hazards": [list(h) for h in d.hazards],
     }
+    if d.planar is not None and d.planar.free is not None:
+        b.part.data["threshold"]["planar"]["free_eight_bar"] = list(d.planar.free)
     return b.finish({pins[j]: loads[j] for j in range(n_inputs)})
 
 

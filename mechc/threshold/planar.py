@@ -20,8 +20,8 @@ and the continuous p1 (AF/AD), p2 (BE/BG), F's offset from AD, K, FJ, JK: Sobol 
 Nelder-Mead on the best few. The separator's first-order motion explains which classes it can
 serve: a point on link AD moves as crank pin A plus a rotation of AD, so cranks B and C move F
 along the same direction (to first order). For x1(x2 xor x3) that is enough; for the multiplexer
-class (FV 27) the held sets cannot be disjoint unless all three directions differ, and the search
-finds no positive separation (reported, see docs/threshold.md §2).
+class (FV 27) it is not, and the *free eight-bar* (:func:`free_layout`: AD tilted, E a coupler
+point of BG, searched by :mod:`mechc.threshold.freebar`) serves it (docs/threshold.md §2).
 """
 
 from __future__ import annotations
@@ -35,9 +35,9 @@ from scipy.optimize import minimize
 from scipy.stats import qmc
 
 from mechc.threshold.functions import input_matrix
-from mechc.threshold.geometry import line_angle_deg
+from mechc.threshold.geometry import branch_of, line_angle_deg, polar
 from mechc.threshold.linkage import MAX_LINK, MAX_TURN_DEG, MIN_LINK, ThresholdLoop
-from mechc.threshold.separator import Proportions, SeparatorLayout, layout
+from mechc.threshold.separator import Proportions, SeparatorLayout, input_stroke, layout
 
 P1_MAX = 4.0 / 3.0  # F at most l/3 beyond D, as for threshold generators
 P2_RANGE = (0.2, 1.5)  # E at most l/2 beyond G
@@ -56,6 +56,42 @@ def planar_layout(p1: float, p2: float, offset: float, mu_min_deg: float = 45.0
     p1, BE/BG = p2, F ``offset`` x AD to the left of A -> D. The weight pattern is nominal."""
     pr = Proportions((1, 1, 1), (1 - p1, p1 * (1 - p2), p1 * p2), p1, p2)
     return layout((1, 1, 1), mu_min_deg, proportions=pr, f_offset=offset)
+
+
+#: Parameters of the free eight-bar (units of l, angles in rad, every input at t = 0): AD's
+#: angle from the vertical (clockwise), |AD|, direction of D -> E, |DE|, direction of B -> G
+#: (|BG| = l), E's coordinates on link BG (along B -> G, and to its left), |CG|, direction of
+#: C -> G, F's coordinates on link AD (along A -> D, and to its left).
+FREE_NAMES = ("beta", "AD", "gamma", "DE", "BG_dir", "BE", "E_left", "CG", "CG_dir", "AF",
+              "F_left")
+
+
+def free_layout(x: tuple[float, ...], mu_min_deg: float = 45.0) -> SeparatorLayout:
+    """The eight-bar with every proportion free (:data:`FREE_NAMES`): same links, joints and
+    cranks as :func:`~mechc.threshold.separator.layout`, but AD tilted and E a coupler point of
+    BG, so that the three cranks move D's direction, E and F in genuinely different ways."""
+    beta, ad, gam, de, bg_dir, be, e_left, cg, cg_dir, af, f_left = (float(v) for v in x)
+    s_i, _alpha = input_stroke(mu_min_deg)
+    delta = float(np.arcsin(s_i / 2))
+    a0 = np.array([-np.sin(delta), np.cos(delta)])  # pin A at t = 0, X_A at the origin
+    d0 = a0 + polar(np.pi / 2 - beta, ad)
+    e0 = d0 + polar(gam, de)
+    ub = polar(bg_dir)
+    b0 = e0 - be * ub - e_left * np.array([-ub[1], ub[0]])
+    g0 = b0 + ub
+    c0 = g0 - polar(cg_dir, cg)
+    lift = 2 * np.cos(delta)
+    centres = {}
+    for c, pin0 in (("A", a0), ("B", b0), ("C", c0)):
+        xc = pin0 - a0
+        centres[c] = ((float(xc[0]), float(xc[1])), (float(xc[0]), float(xc[1] + lift)))
+    lengths = {"crank": 1.0, "AD": ad, "DE": de, "AF": af, "BG": 1.0, "CG": cg, "BE": be}
+    p1 = af / ad
+    pr = Proportions((1, 1, 1), (1 - p1, p1 * (1 - be), p1 * be), p1, be)
+    tilts = {"DE": float((gam - np.pi + np.pi) % (2 * np.pi) - np.pi), "CG": float(cg_dir)}
+    branches = {"D": branch_of(a0, e0, d0), "G": branch_of(b0, c0, g0)}
+    return SeparatorLayout(pr, s_i, delta, lengths, centres, tilts, branches, f_left / ad,
+                           e_left)
 
 
 @dataclass
@@ -170,8 +206,11 @@ class PlanarGenerator:
     loop: ThresholdLoop
     separation_deg: float  # on the fine samples
     min_transmission: float  # separator and loop, fine samples (deg)
+    free: tuple[float, ...] | None = None  # free eight-bar parameters (FREE_NAMES), if any
 
     def layout(self, mu_min_deg: float) -> SeparatorLayout:
+        if self.free is not None:
+            return free_layout(self.free, mu_min_deg)
         return planar_layout(self.p1, self.p2, self.offset, mu_min_deg)
 
 
@@ -274,8 +313,8 @@ def search_planar(canonical: tuple[int, ...], mu_min_deg: float = 45.0, seed: in
 #: Results of :func:`search_planar` per NPN class (canonical truth table), kept so that a design
 #: costs no search: (wiring function h, (p1, p2, offset, K_x, K_y, FJ, JK) in units of l, branch
 #: of J). Every design built from them is re-analysed on fine samples and checked.
-#: Only x1(x2 xor x3) has one; the multiplexer class's best search result separates its held sets
-#: by 0.09 deg on the screening samples and 0.00 deg on fine samples (docs/threshold.md §2).
+#: Only x1(x2 xor x3) has one; for the multiplexer class this eight-bar's best search result
+#: separates the held sets by 0.09 deg (0.00 on fine samples): see FREE_DESIGNS.
 PLANAR_DESIGNS: dict[tuple[int, ...], tuple[tuple[int, ...], tuple[float, ...], int]] = {
     # x1 (x2 xor x3), FV 6: separation 33.8 deg, search 70 s (seed 5)
     (0, 0, 0, 0, 0, 1, 1, 0): ((0, 1, 1, 0, 0, 0, 0, 0),
@@ -284,11 +323,30 @@ PLANAR_DESIGNS: dict[tuple[int, ...], tuple[tuple[int, ...], tuple[float, ...], 
 }
 
 
+#: Results of :func:`mechc.threshold.freebar.search_free` per NPN class: (wiring function h,
+#: free eight-bar parameters (FREE_NAMES), loop (K_x, K_y, FJ, JK), branch of J), units of l.
+#: For the classes the eight-bar of :data:`PLANAR_DESIGNS` cannot serve (docs/threshold.md §2).
+FREE_DESIGNS: dict[tuple[int, ...], tuple[tuple[int, ...], tuple[float, ...],
+                                          tuple[float, ...], int]] = {
+    # multiplexer x1 ? (x2 + x3') : x2 x3, FV 27: separation 58.7 deg on 50 samples per move,
+    # one transition (output 0 | 1 along phi); search 121 s (seed 1: score 56.4 deg on 10
+    # samples), then one more Nelder-Mead pass on 25 samples per change
+    (0, 0, 0, 1, 1, 0, 1, 1): ((0, 0, 0, 1, 1, 0, 1, 1),
+                               (-1.194974, 0.62606, 1.086716, 0.822484, 1.279785, 0.933223,
+                                -0.04271, 0.895012, -0.302869, 0.520251, -0.445225),
+                               (0.33843, 2.320938, 1.003855, 0.333334), -1),
+}
+
+
 @lru_cache(maxsize=8)
 def planar_generator(canonical: tuple[int, ...], mu_min_deg: float = 45.0, samples: int = 50
                      ) -> PlanarGenerator | None:
-    """The planar generator of an NPN class, or None if there is none (the class is not in
-    :data:`PLANAR_DESIGNS`, or its design no longer separates the held sets)."""
+    """The planar generator of an NPN class, or None if there is none (the class is in neither
+    :data:`PLANAR_DESIGNS` nor :data:`FREE_DESIGNS`, or its design no longer separates the held
+    sets)."""
+    if canonical in FREE_DESIGNS:
+        h, x, (kx, ky, fj, jk), branch = FREE_DESIGNS[canonical]
+        return build_free(h, x, (kx, ky, fj, jk), branch, mu_min_deg, samples)
     if canonical not in PLANAR_DESIGNS:
         return None
     h, (p1, p2, q, kx, ky, fj, jk), branch = PLANAR_DESIGNS[canonical]
@@ -300,7 +358,24 @@ def build_planar(h: tuple[int, ...], x: tuple[float, ...], branch: int,
     """Analyse a planar design on ``samples`` per move: None if loop FJK cannot close or the
     held sets of outputs 0 and 1 are not separated."""
     p1, p2, q, kx, ky, fj, jk = x
-    ms = move_samples(planar_layout(p1, p2, q, mu_min_deg), samples)
+    return _build(h, planar_layout(p1, p2, q, mu_min_deg), (kx, ky, fj, jk), branch, samples,
+                  (p1, p2, q), None)
+
+
+def build_free(h: tuple[int, ...], x: tuple[float, ...], loop: tuple[float, ...], branch: int,
+               mu_min_deg: float = 45.0, samples: int = 50) -> PlanarGenerator | None:
+    """Analyse a free eight-bar design (:func:`free_layout`) like :func:`build_planar`."""
+    lay = free_layout(x, mu_min_deg)
+    p = lay.proportions
+    return _build(h, lay, loop, branch, samples, (p.p1, p.p2, lay.f_offset),
+                  tuple(float(v) for v in x))
+
+
+def _build(h: tuple[int, ...], lay: SeparatorLayout, loop: tuple[float, ...], branch: int,
+           samples: int, p: tuple[float, float, float], free: tuple[float, ...] | None
+           ) -> PlanarGenerator | None:
+    kx, ky, fj, jk = loop
+    ms = move_samples(lay, samples)
     with np.errstate(all="ignore"):
         phi, trans, closes = cam_angles(ms.F[None], np.array([[kx, ky]]), np.array([fj]),
                                         np.array([jk]), branch)
@@ -311,7 +386,7 @@ def build_planar(h: tuple[int, ...], x: tuple[float, ...], branch: int,
     ang = np.arctan2(w[:, 1], w[:, 0])
     ref = float(np.arctan2(np.sin(ang).mean(), np.cos(ang).mean()))
     loop = ThresholdLoop((kx, ky), fj, jk, branch, 1, ref)
-    return PlanarGenerator(h, p1, p2, q, loop, sep, float(min(trans[0], ms.min_transmission)))
+    return PlanarGenerator(h, *p, loop, sep, float(min(trans[0], ms.min_transmission)), free)
 
 
 def main() -> None:

@@ -128,6 +128,9 @@ class SeparatorLayout:
     #: F's distance from the line AD, as a fraction of AD, to the left of A -> D (0: F on the
     #: line, as in every threshold generator; see mechc.threshold.planar for the others)
     f_offset: float = 0.0
+    #: E's distance from the line BG, as a fraction of BG, to the left of B -> G (0 in every
+    #: threshold generator; the free eight-bar of mechc.threshold.planar makes E a coupler point)
+    e_offset: float = 0.0
 
     @property
     def cranks(self) -> tuple[str, ...]:
@@ -160,6 +163,9 @@ class SeparatorLayout:
             C = tips["C"]
             G = circle_intersection(B, L["BG"], C, L["CG"], self.branches["G"], "loop BGC")
             E = B + (L["BE"] / L["BG"]) * (G - B)
+            if self.e_offset:
+                E = E + self.e_offset * np.stack([B[..., 1] - G[..., 1], G[..., 0] - B[..., 0]],
+                                                 -1)
             out.update(C=C, G=G)
         D = circle_intersection(A, L["AD"], E, L["DE"], self.branches["D"], "loop ADE")
         F = A + (L["AF"] / L["AD"]) * (D - A)

@@ -17,11 +17,8 @@ from mechc.netlist.mapping import MapOptions, map_equations
 from mechc.netlist.types import evaluate_type
 from mechc.spec.boolfile import parse_bool
 from mechc.threshold.functions import input_matrix, truth_table_from_fv
-from mechc.threshold.weights import static_hazards
 from stdlib.threshold import ThresholdCell, truth_table
 from tests.threshold.test_threshold_generator import (
-    REASON,
-    STILL_HAZARDOUS,
     UNAVOIDABLE,
     min_thresholds,
 )
@@ -121,11 +118,7 @@ GENERATORS = [fv for fv in range(256) if min_thresholds(fv) > 0
               and len({k for k in range(3) if any(truth_table_from_fv(fv)[m] !=
                                                   truth_table_from_fv(fv)[m ^ (4 >> k)]
                                                   for m in range(8))}) >= 2]
-XFAIL = pytest.mark.xfail(strict=True, reason=REASON)
-
-
-@pytest.mark.parametrize("fv", [pytest.param(fv, marks=XFAIL) if fv in STILL_HAZARDOUS else fv
-                                for fv in GENERATORS])
+@pytest.mark.parametrize("fv", GENERATORS)
 def test_cell_kinematic_proof(fv):
     tt = truth_table_from_fv(fv)
     out, meta, mu, bad, poses, p = run(fv)
@@ -146,27 +139,12 @@ def test_cell_kinematic_proof(fv):
 def test_cured_cells_are_planar_and_keep_their_params():
     # the 24 cured functions: the cell's params are still the minimum threshold realisation
     # (the logic), the mechanism is the planar generator
-    for fv in sorted(UNAVOIDABLE - STILL_HAZARDOUS):
+    for fv in sorted(UNAVOIDABLE):
         c, p = part(fv)
         assert len(c.params["thresholds"]) == min_thresholds(fv)
         assert truth_table(c.params, 3) == truth_table_from_fv(fv)
         info = p.data["threshold"]
         assert info["mechanism"] == "planar" and info["hazards"] == []
-
-
-@pytest.mark.parametrize("fv", sorted(STILL_HAZARDOUS))
-def test_cell_glitches_only_on_the_predicted_hazards(fv):
-    tt = truth_table_from_fv(fv)
-    out, meta, mu, bad, _, p = run(fv)
-    assert bad == 0 and mu >= 45.0
-    w = p.data["threshold"]["mechanism_weights"]
-    predicted = set()
-    for a, j in static_hazards(w, tt):
-        predicted |= {(a, j), (a | (4 >> j), j)}
-    paths = out[8:].reshape(len(meta), SAMPLES)
-    seen = {(a, j) for (a, b, j), o in zip(meta, paths)
-            if tt[a] == tt[b] and np.abs(o - tt[a]).max() > MARGIN}
-    assert seen == predicted and len(seen) in (2, 6)
 
 
 def test_part_geometry_is_consistent_at_the_design_pose():
