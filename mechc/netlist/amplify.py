@@ -4,14 +4,15 @@ Two reasons, both from ``001_…`` §2.6 and Appendix B:
 
 - **force** — a net whose driver cannot move its loads (an input actuator that is asked for more
   than its rating, a MEMORY loop whose force demand grows every time round) gets its loads
-  split into groups of at most the amplifier's measured fan-out, each group behind its own
+  split into groups of at most ``Amplifier.fanout_max`` loads, each group behind its own
   AMPLIFIER; the amplifier's input costs only its slider's friction, its output comes from the
   motor. Every load of the net moves behind an amplifier, so all its paths keep the same delay
   (a delay on one path only is the SET/RESET overlap of Appendix B.2).
 - **snap** — an output that must hold while an input travels but whose generator moves partway
   because a MEMORY switches before that input has finished its stroke (the output is X in the
   ternary analysis with the memories free to switch). The AMPLIFIER's bistable toggle switches
-  only near the end of its input's stroke, so the partial motion never reaches the output.
+  only when its input passes its switching point (half stroke in the closed form, the wedge in
+  the dynamics), so the partial motion never reaches the output.
 
 Both are plain functions ``Netlist -> Netlist``; the pipeline decides where.
 """
@@ -24,8 +25,8 @@ from mechc.errors import DesignError
 from mechc.library import Library
 from mechc.netlist.ir import CellInst, Netlist
 
-#: Used when the library's AMPLIFIER does not state a measured fan-out.
-DEFAULT_FANOUT = 3
+#: Used when the library's AMPLIFIER does not state how many loads it may drive.
+DEFAULT_FANOUT = 2
 
 
 def amplifier_cell(lib: Library):
@@ -36,7 +37,7 @@ def amplifier_cell(lib: Library):
 
 
 def fanout_limit(lib: Library) -> int:
-    """How many loads one AMPLIFIER drives (its measured figure, a cell class attribute)."""
+    """How many loads the mapper puts on one AMPLIFIER (a cell class attribute)."""
     cls = amplifier_cell(lib)
     return int(getattr(cls, "fanout_max", DEFAULT_FANOUT))
 
