@@ -343,9 +343,23 @@ def cmd_simulate(args) -> int:
             bar.total = total
             bar.update(done, "input changes")
 
+        st = None
+        if any(getattr(args, o) is not None for o in ("dt", "iterations", "move_time")):
+            from mechc.mech.dynamics import DynSettings
+            from mechc.sim.seqmech import settle_allowance
+
+            st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke)
+            st.settle_time = max(st.settle_time, settle_allowance(design, lib))
+            for opt in ("dt", "iterations", "move_time"):
+                v = getattr(args, opt)
+                if v is not None:
+                    if v <= 0:
+                        raise UsageError(f"--{opt.replace('_', '-')} must be positive")
+                    setattr(st, opt, v)
         try:
-            report = prove_sequential_dynamic(design, spec, lib, tolerance=args.tolerance,
-                                              seed=args.seed, progress=step)
+            report = prove_sequential_dynamic(design, spec, lib, settings=st,
+                                              tolerance=args.tolerance, seed=args.seed,
+                                              progress=step)
         finally:
             bar.close()
     elif args.level == "kinematic":

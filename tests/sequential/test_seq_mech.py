@@ -63,3 +63,15 @@ def test_three_variable_table_passes_mechanism_levels(cli, tmp_path, level):
     spec.write_text(FOUR_STATE)
     code, stdout, err = cli("simulate", spec, "--level", level)
     assert code == 0 and "PASSED" in stdout, stdout[-2000:] + err
+
+
+def test_sequential_dynamic_reports_a_too_large_time_step(cli, tmp_path):
+    # the solver settings reach the sequential proof; 8x the default step breaks the contacts,
+    # which must be reported as failures, never a pass
+    rep = tmp_path / "r.json"
+    code, stdout, _ = cli("simulate", EXAMPLES / "gated_latch.fsm", "--dt", "0.002",
+                          "--report", rep)
+    assert code == 1 and "FAILED" in stdout
+    r = json.loads(rep.read_text())
+    assert r["settings"]["dt"] == 0.002
+    assert set(r["failure_kinds"]) & {"contact", "solver", "settle"}
