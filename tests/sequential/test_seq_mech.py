@@ -73,5 +73,5 @@ def test_sequential_dynamic_reports_a_too_large_time_step(cli, tmp_path):
                           "--report", rep)
     assert code == 1 and "FAILED" in stdout
     r = json.loads(rep.read_text())
-    assert r["settings"]["dt"] == 0.002
+    assert r["settings"]["dt_s"] == 0.002
     assert set(r["failure_kinds"]) & {"contact", "solver", "settle"}
