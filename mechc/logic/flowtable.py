@@ -43,6 +43,7 @@ from mechc.spec.sequential import (
     SeqSpec,
     SequentialError,
     bits_text,
+    memory_targets,
     settle_async,
 )
 
@@ -956,15 +957,7 @@ def check_equations(spec: SeqSpec, se: SeqEquations) -> dict:
     def excite_at(x):
         def f(q):
             i = (x << v) | q
-            tgt = ov = 0
-            for j in range(v):
-                b = 1 << (v - 1 - j)
-                s, r = S[j][i], R[j][i]
-                if s and r:
-                    ov |= b
-                if s or (q & b and not r):
-                    tgt |= b
-            return tgt, ov
+            return memory_targets(((S[j][i], R[j][i]) for j in range(v)), q, v)
         return f
 
     x0, st0 = initial_total_state(spec)

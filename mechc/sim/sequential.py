@@ -38,6 +38,7 @@ from mechc.spec.sequential import (
     bits_text,
     describe_total,
     initial_total_state,
+    memory_targets,
     next_stable,
     output_values,
     settle_async,
@@ -135,15 +136,7 @@ class SeqNetlist:
     def excite(self, x: int):
         def f(q: int) -> tuple[int, int]:
             vals = self.eval(x, q)
-            target = ov = 0
-            for j in range(self.m):
-                b = 1 << (self.m - 1 - j)
-                s, r = self.sr(vals, j)
-                if s and r:
-                    ov |= b
-                if s or (q & b and not r):
-                    target |= b
-            return target, ov
+            return memory_targets((self.sr(vals, j) for j in range(self.m)), q, self.m)
 
         return f
 

@@ -15,7 +15,7 @@ over inputs + memories is ``(x << m) | q``.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -399,17 +399,22 @@ def _sr_excite(spec: SeqSpec, x: int) -> Callable[[int], tuple[int, int]]:
 
     def excite(q: int) -> tuple[int, int]:
         i = (x << m) | q
-        target = ov = 0
-        for j in range(m):
-            b = 1 << (m - 1 - j)
-            s, r = bool(S[j][i]), bool(R[j][i])
-            if s and r:
-                ov |= b
-            if s or (q & b and not r):
-                target |= b
-        return target, ov
+        return memory_targets(((S[j][i], R[j][i]) for j in range(m)), q, m)
 
     return excite
+
+
+def memory_targets(sr: Iterable[tuple[int, int]], q: int, m: int) -> tuple[int, int]:
+    """Where each of ``m`` memories (bit j from the MSB of ``q``) heads given its (SET, RESET):
+    Q' = S + Q·R̄; returns (target state, bits whose SET and RESET are both on)."""
+    target = ov = 0
+    for j, (s, r) in enumerate(sr):
+        b = 1 << (m - 1 - j)
+        if s and r:
+            ov |= b
+        if s or (q & b and not r):
+            target |= b
+    return target, ov
 
 
 def initial_total_state(spec: SeqSpec) -> tuple[int, State]:
