@@ -239,12 +239,9 @@ def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> dict:
         fail("initial", f"the circuit does not settle to one state at power-up "
                         f"({' '.join(spec.inputs)} = {bits_text(x0, spec.n)}, {mem_text(q_init)})")
         return _report(spec, t0, failures, kinds, hazards, 0, 0, m)
-    start = (x0, s0, st.finals[0])
-    seen = {start}
-    todo = deque([start])
-    transitions = 0
-    while todo:
-        x, s, q = todo.popleft()
+    states = transitions = 0
+    for (x, s, q), changes in _reachable(sn, spec, (x0, s0, st.finals[0])):
+        states += 1
         vals = sn.eval(x, q)
         want = output_values(spec, s, x)
         for o, w in want.items():
@@ -252,12 +249,10 @@ def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> dict:
             if w is not None and got != w:
                 fail("output", f"{o}: expected {w}, got {got} at {describe_total(spec, x, s)} "
                                f"({mem_text(q)})", output=o, expected=w, got=got)
-        for x2 in allowed_changes(spec, s, x):
+        for x2, s2, res in changes:
             transitions += 1
-            s2 = next_stable(spec, s, x, x2)
             moved = _moved(spec, x, x2)
             where = f"{describe_total(spec, x, s)}, {moved}"
-            res = settle_async(sn.excite(x2), q, m)
             for qq, j in res.overlaps[:1]:
                 fail("overlap", f"SET and RESET of {sn.mem_nets[j]} both on after {where} "
                                 f"({mem_text(qq)})", memory=sn.mem_nets[j])
@@ -277,12 +272,28 @@ def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> dict:
                                    f"{'hold' if hold else 'change once'})", output=o)
             _ternary(sn, spec, nl, x, x2, q, s, s2, before, after, where, fail, hazards,
                      res.finals[0] if res.finals else q)
+    return _report(spec, t0, failures, kinds, hazards, states, transitions, m)
+
+
+def _reachable(sn: SeqNetlist, spec: SeqSpec, start: tuple):
+    """Breadth-first over the reachable stable total states (x, spec state, memory code): per
+    state, its specified single-input changes as (x2, next spec state, Settling). A change
+    whose memories may oscillate leads nowhere (the proof reports it)."""
+    seen, todo = {start}, deque([start])
+    while todo:
+        x, s, q = todo.popleft()
+        changes = []
+        for x2 in allowed_changes(spec, s, x):
+            res = settle_async(sn.excite(x2), q, sn.m)
+            s2 = next_stable(spec, s, x, x2)
+            changes.append((x2, s2, res))
+            if res.cycle:
+                continue
             for qf in res.finals[:1]:
-                node = (x2, s2, qf)
-                if node not in seen:
-                    seen.add(node)
-                    todo.append(node)
-    return _report(spec, t0, failures, kinds, hazards, len(seen), transitions, m)
+                if (x2, s2, qf) not in seen:
+                    seen.add((x2, s2, qf))
+                    todo.append((x2, s2, qf))
+        yield (x, s, q), changes
 
 
 def outputs_needing_snap(nl: Netlist, spec: SeqSpec) -> dict[str, str]:
@@ -298,14 +309,10 @@ def outputs_needing_snap(nl: Netlist, spec: SeqSpec) -> dict[str, str]:
     st = settle_async(sn.excite(x0), sn.initial(), sn.m)
     if st.overlaps or st.cycle or len(st.finals) != 1:
         return {}
-    start = (x0, s0, st.finals[0])
-    seen, todo = {start}, deque([start])
     found: dict[str, str] = {}
-    while todo:
-        x, s, q = todo.popleft()
+    for (x, s, q), changes in _reachable(sn, spec, (x0, s0, st.finals[0])):
         before = output_values(spec, s, x)
-        for x2 in allowed_changes(spec, s, x):
-            s2 = next_stable(spec, s, x, x2)
+        for x2, s2, _res in changes:
             after = output_values(spec, s2, x2)
             t = ternary_transition(sn, x, x2, q)
             for o in spec.outputs:
@@ -313,12 +320,6 @@ def outputs_needing_snap(nl: Netlist, spec: SeqSpec) -> dict[str, str]:
                 hold = before[o] is not None and before[o] == after[o]
                 if hold and o not in found and t["start"][net] != X and t["after_a"][net] == X:
                     found[o] = f"{describe_total(spec, x, s)}, {_moved(spec, x, x2)}"
-            res = settle_async(sn.excite(x2), q, sn.m)
-            for qf in res.finals[:1]:
-                node = (x2, s2, qf)
-                if node not in seen:
-                    seen.add(node)
-                    todo.append(node)
     return found
 
 
