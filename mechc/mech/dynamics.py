@@ -108,6 +108,7 @@ class Scene:
     servos: dict[str, tuple[pymunk.Body, str]] = field(default_factory=dict)
     joints: list[_J] = field(default_factory=list)
     touches: list = field(default_factory=list)  # (joint, shapes) of shape contacts
+    profiles: list = field(default_factory=list)  # per touch: (start points, segment vectors)
     state: dict[str, float] = field(default_factory=dict)  # current input values
     mem_state: dict[str, float] = field(default_factory=dict)  # stateful cells (MEMORY)
     watch: list[str] = field(default_factory=list)  # slider bodies whose u each move records
@@ -285,6 +286,12 @@ class Scene:
         roller.friction = 1.0
         self.space.add(*shapes)
         self.touches.append((j, shapes))
+        if j.profile:  # the segments in the profile body's frame, for the overrun measure
+            a = np.array([[sh.a.x, sh.a.y] for sh in shapes[:-1]])
+            b = np.array([[sh.b.x, sh.b.y] for sh in shapes[:-1]])
+            self.profiles.append((a, b - a))
+        else:
+            self.profiles.append(None)
 
     def _add_spring(self, s) -> None:
         c = pymunk.DampedSpring(self._b(s.a), self._b(s.b), self._anchor(s.a, s.pa),
@@ -390,38 +397,18 @@ class Scene:
         roller's radius less its centre's distance to the profile (a polyline) or to the
         other circle. (pymunk's own contact query returns nothing for most touching pairs.)"""
         worst = 0.0
-        for _, shapes in self.touches:
+        for (_, shapes), profile in zip(self.touches, self.profiles):
             roller = shapes[-1]
             c = roller.body.local_to_world(roller.offset)
             first = shapes[0]
-            if isinstance(first, pymunk.Circle):
+            if profile is None:  # two circles
                 o = first.body.local_to_world(first.offset)
                 d = math.hypot(c[0] - o[0], c[1] - o[1])
                 worst = max(worst, first.radius + roller.radius - d)
                 continue
-            d = self._polyline_distance(shapes, c)
+            d = _polyline_distance(profile, first.body, c)
             worst = max(worst, roller.radius - d)
         return worst
-
-    def _polyline_distance(self, shapes, c) -> float:
-        """Distance from world point ``c`` to a touch's profile segments (numpy, vectorised)."""
-        cache = self.__dict__.setdefault("_profiles", {})
-        key = id(shapes)
-        if key not in cache:
-            a = np.array([[s.a.x, s.a.y] for s in shapes[:-1]])
-            b = np.array([[s.b.x, s.b.y] for s in shapes[:-1]])
-            cache[key] = (a, b - a)
-        a, ab = cache[key]
-        body = shapes[0].body
-        ca, sa = math.cos(body.angle), math.sin(body.angle)
-        # the point in the profile body's frame (segments are stored in that frame)
-        dx, dy = c[0] - body.position.x, c[1] - body.position.y
-        px, py = ca * dx + sa * dy, -sa * dx + ca * dy
-        rx, ry = px - a[:, 0], py - a[:, 1]
-        ll = ab[:, 0] ** 2 + ab[:, 1] ** 2
-        t = np.clip((rx * ab[:, 0] + ry * ab[:, 1]) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
-        ex, ey = rx - t * ab[:, 0], ry - t * ab[:, 1]
-        return float(np.sqrt(np.min(ex * ex + ey * ey)))
 
     def pose_of(self, bid: str, pos, ang) -> Poses:
         """The scene's pose of one body in the closed form's terms (for signals)."""
@@ -638,3 +625,18 @@ def _spin_is_invisible(scene: Scene, bid: str) -> bool:
         if anchor is None or abs(anchor) > 1e-9:
             return False
     return True
+
+
+def _polyline_distance(profile, body: pymunk.Body, c) -> float:
+    """Distance from world point ``c`` to a touch's profile segments (stored in ``body``'s
+    frame as start points and segment vectors), vectorised over the segments."""
+    a, ab = profile
+    ca, sa = math.cos(body.angle), math.sin(body.angle)
+    # the point in the profile body's frame (segments are stored in that frame)
+    dx, dy = c[0] - body.position.x, c[1] - body.position.y
+    px, py = ca * dx + sa * dy, -sa * dx + ca * dy
+    rx, ry = px - a[:, 0], py - a[:, 1]
+    ll = ab[:, 0] ** 2 + ab[:, 1] ** 2
+    t = np.clip((rx * ab[:, 0] + ry * ab[:, 1]) / np.where(ll > 0, ll, 1.0), 0.0, 1.0)
+    ex, ey = rx - t * ab[:, 0], ry - t * ab[:, 1]
+    return float(np.sqrt(np.min(ex * ex + ey * ey)))
