@@ -305,6 +305,25 @@ def load_design_or_spec(path: str, args):
     return _compile(path, args, mechanism=getattr(args, "level", None) != "logic")
 
 
+#: simulate's options that set the pymunk solver (DynSettings fields of the same names).
+SOLVER_OPTIONS = ("dt", "iterations", "move_time")
+
+
+def _solver_settings(args, design):
+    """Default dynamic settings with the solver options the user gave."""
+    from mechc.mech.dynamics import DynSettings
+
+    st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
+                     if design.mechanism else 0.1)
+    for opt in SOLVER_OPTIONS:
+        v = getattr(args, opt)
+        if v is not None:
+            if v <= 0:
+                raise UsageError(f"--{opt.replace('_', '-')} must be positive")
+            setattr(st, opt, v)
+    return st
+
+
 def cmd_simulate(args) -> int:
     from mechc.library import load_library
     from mechc.writer import dumps, write_atomic
@@ -344,18 +363,11 @@ def cmd_simulate(args) -> int:
             bar.update(done, "input changes")
 
         st = None
-        if any(getattr(args, o) is not None for o in ("dt", "iterations", "move_time")):
-            from mechc.mech.dynamics import DynSettings
+        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
             from mechc.sim.seqmech import settle_allowance
 
-            st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke)
+            st = _solver_settings(args, design)
             st.settle_time = max(st.settle_time, settle_allowance(design, lib))
-            for opt in ("dt", "iterations", "move_time"):
-                v = getattr(args, opt)
-                if v is not None:
-                    if v <= 0:
-                        raise UsageError(f"--{opt.replace('_', '-')} must be positive")
-                    setattr(st, opt, v)
         try:
             report = prove_sequential_dynamic(design, spec, lib, settings=st,
                                               tolerance=args.tolerance, seed=args.seed,
@@ -367,19 +379,10 @@ def cmd_simulate(args) -> int:
 
         report = prove_kinematic(design, spec, lib, tolerance=args.tolerance, seed=args.seed)
     else:
-        from mechc.mech.dynamics import DynSettings
         from mechc.sim.dynamic import PRUNE_DEFAULT, prove_dynamic
         from mechc.ui import Progress
 
-        st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
-                         if design.mechanism else 0.1)
-        for opt, field_name in (("dt", "dt"), ("iterations", "iterations"),
-                                ("move_time", "move_time")):
-            v = getattr(args, opt)
-            if v is not None:
-                if v <= 0:
-                    raise UsageError(f"--{opt.replace('_', '-')} must be positive")
-                setattr(st, field_name, v)
+        st = _solver_settings(args, design)
         bar = Progress(1, f"dynamic proof of {Path(args.design).name}")
 
         def tick(done, total):
@@ -390,7 +393,7 @@ def cmd_simulate(args) -> int:
             if args.accuracy is not None:
                 from mechc.sim.accuracy import prove_with_accuracy
 
-                if any(getattr(args, o) is not None for o in ("dt", "iterations", "move_time")):
+                if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
                     raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
                 report = prove_with_accuracy(design, spec, lib, args.accuracy,
                                              tolerance=args.tolerance, extra=args.cases,
