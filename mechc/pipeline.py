@@ -234,10 +234,7 @@ def _memory_checks(design: Design, lib: Library, stats) -> list:
     from mechc.sim.seqmech import prove_sequential_kinematic
 
     r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)
-    per_cell: dict[str, int] = {}
-    for f in r["failures"]:
-        if f["kind"] == "S·R overlap":
-            per_cell[f["cell"]] = per_cell.get(f["cell"], 0) + 1
+    per_cell = r["overlaps_by_cell"]
     mems = [c.id for c in design.netlist.cells.values() if c.type == "MEMORY"]
     return [Check("SET and RESET apart (transitions where both press)", f"MEMORY {c}",
                   float(per_cell.get(c, 0)), 0.0, "<=") for c in mems]

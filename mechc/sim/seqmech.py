@@ -41,9 +41,13 @@ class _Failures:
     def __init__(self):
         self.items: list[dict] = []
         self.counts: dict[str, int] = {}
+        self.by_cell: dict[tuple[str, str], int] = {}
 
     def add(self, kind: str, **info) -> None:
         self.counts[kind] = self.counts.get(kind, 0) + 1
+        if "cell" in info:  # every one counted per cell, also past the listed ones
+            key = (kind, info["cell"])
+            self.by_cell[key] = self.by_cell.get(key, 0) + 1
         if len(self.items) < MAX_LISTED:
             self.items.append({"kind": kind, **info})
 
@@ -129,6 +133,8 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
             "steps": steps, "cases": steps, "memories": len(mems),
             "tolerance_fraction": tolerance,
             "failure_count": fails.total, "failure_kinds": fails.counts,
+            "overlaps_by_cell": {c: n for (k, c), n in fails.by_cell.items()
+                                 if k == "S·R overlap"},
             "failures": fails.items, "max_deviation_fraction": round(dev[0], 6),
             "min_margin_fraction": round(0.5 - dev[0], 6),
             "seconds": round(time.perf_counter() - t0, 3)}
