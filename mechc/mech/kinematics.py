@@ -412,11 +412,10 @@ def _lever_from_rod(j: Joint, lever: Body, other: Body, poses: Poses, size: int)
         A = 0.5 * (r2 - L2) * inv
         A += 0.5
         H2 = r2 * inv - A * A
-    ok = H2 >= 0
-    Hc = np.sqrt(np.maximum(H2, 0.0))  # past the toggle: the pin on the line of centres
+        ok = H2 >= 0
+        H = np.sqrt(H2)  # unsolved states (past the toggle): NaN pin, NaN angle
     side = float(np.sign(_cross((theirs[0] - P[0], theirs[1] - P[1]),
                                 (mine[0] - P[0], mine[1] - P[1])))) or 1.0
-    H = np.where(ok, Hc, np.nan)  # unsolved states: NaN pin, NaN angle
     rx, ry = A * dx, A * dy
     if side > 0:
         rx -= H * dy
@@ -431,7 +430,8 @@ def _lever_from_rod(j: Joint, lever: Body, other: Body, poses: Poses, size: int)
         np.add(theta, 2 * np.pi, out=theta, where=theta < -np.pi)
     else:
         np.subtract(theta, 2 * np.pi, out=theta, where=theta >= np.pi)
-    poses.theta[lever.id] = np.broadcast_to(theta, (size,)).copy()
+    poses.theta[lever.id] = theta if theta.shape == (size,) else np.broadcast_to(
+        theta, (size,)).copy()
     other_bad = poses.bad.get(other.id if other else GROUND)
     bad = ~np.broadcast_to(ok, (size,))
     poses.mark(lever.id, bad if other_bad is None else bad | other_bad)
@@ -441,10 +441,14 @@ def _lever_from_rod(j: Joint, lever: Body, other: Body, poses: Poses, size: int)
     if other is not None:
         poses.placed[_key(other, theirs)] = (cx, cy)
     # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the toggle
+    # (fmax takes 0 over H's NaN there)
     cos_part = np.abs(0.5 - 0.5 * (r2 + L2) * inv)
-    gamma = np.broadcast_to(np.degrees(np.arctan2(Hc, cos_part)), (size,))
-    poses.transmission[j.id] = gamma.copy()
-    poses.singular_margin[j.id] = gamma.copy()
+    gamma = np.arctan2(np.fmax(H, 0.0), cos_part)
+    gamma *= 180.0 / np.pi
+    if gamma.shape != (size,):
+        gamma = np.broadcast_to(gamma, (size,)).copy()
+    poses.transmission[j.id] = gamma  # read-only from here on: one array serves both
+    poses.singular_margin[j.id] = gamma
 
 
 def _key(body: Body | None, p: Point) -> tuple[str, float, float]:
