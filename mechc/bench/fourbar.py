@@ -20,7 +20,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from mechc.mech.kinematics import position, solve
+from mechc.mech.kinematics import cos_sin, position, solve
 from mechc.mech.model import Body, Joint, Part
 
 GROUND_LEN, CRANK, COUPLER, ROCKER = 40.0, 10.0, 40.0, 30.0  # mm: Grashof crank-rocker
@@ -70,6 +70,57 @@ def pylinkage_linkage(steps_per_turn: int):
     return Linkage([o1, o2, crank, rocker], name="four-bar")
 
 
+def _side() -> float:
+    """Which of the two circle meetings is the design pose's (crank at +90°): +1 for the one
+    left of the line from the rocker pivot to the crank pin."""
+    part, b = mechc_part()
+    o2 = part.bodies[1].pivot
+    ex, ey = 0.0 - o2[0], CRANK - o2[1]
+    return 1.0 if ex * (b[1] - o2[1]) - ey * (b[0] - o2[0]) > 0 else -1.0
+
+
+def bare_rocker_pins(crank_angles: np.ndarray) -> np.ndarray:
+    """The same closed form with nothing but the positions (no transmission, assembly or
+    closure checks, no bookkeeping): the most numpy could give on this four-bar, a floor to
+    read mechc's rate against."""
+    part, b = mechc_part()
+    o2 = part.bodies[1].pivot
+    r2, l2 = ROCKER * ROCKER, COUPLER * COUPLER
+    side = _side()
+    c, s = cos_sin(crank_angles)
+    dx = CRANK * c - o2[0]
+    dy = CRANK * s - o2[1]
+    inv = 1.0 / (dx * dx + dy * dy)
+    a = 0.5 * (r2 - l2) * inv + 0.5
+    h = np.sqrt(r2 * inv - a * a) * side
+    return np.stack((o2[0] + a * dx - h * dy, o2[1] + a * dy + h * dx), axis=1)
+
+
+def _numba_kernel():
+    """The same positions-only closed form as a scalar loop compiled by numba (when numba is
+    installed, as the benchmark extra installs it): what compiling, rather than vectorising,
+    gives on this machine."""
+    import numba
+
+    part, b = mechc_part()
+    ox, oy = part.bodies[1].pivot
+    r2, l2 = ROCKER * ROCKER, COUPLER * COUPLER
+    side = _side()
+
+    @numba.njit(cache=False, fastmath=False)
+    def pins(th, out):
+        for i in range(th.shape[0]):
+            dx = CRANK * math.cos(th[i]) - ox
+            dy = CRANK * math.sin(th[i]) - oy
+            inv = 1.0 / (dx * dx + dy * dy)
+            a = 0.5 * (r2 - l2) * inv + 0.5
+            h = math.sqrt(r2 * inv - a * a) * side
+            out[i, 0] = ox + a * dx - h * dy
+            out[i, 1] = oy + a * dy + h * dx
+
+    return pins
+
+
 @dataclass
 class PeerResult:
     mechc_per_s: float
@@ -78,6 +129,8 @@ class PeerResult:
     pylinkage_backend: str
     max_difference_mm: float  # rocker pin, mechc against pylinkage, same crank angles
     positions: int
+    bare_numpy_per_s: float = math.nan  # positions only, numpy (bare_rocker_pins)
+    numba_kernel_per_s: float | None = None  # positions only, compiled scalar loop
 
 
 # states per vectorised call, cache-sized. A proof's sweep chunks larger (budget // (3 bodies),
@@ -123,5 +176,28 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
             fast_rate = None
     except Exception:  # an optional path of an optional peer: report it missing
         fast_rate = None
+    # floors: the closed form with positions only, vectorised and compiled
+    ref = mechc_rocker_pins(th[:CHUNK])
+    if np.max(np.abs(bare_rocker_pins(th[:CHUNK]) - ref)) > 1e-9:
+        raise AssertionError("the positions-only closed form does not match mechc's")
+    bare_rate = n / _best_of(repeat, lambda: [bare_rocker_pins(th[s:s + CHUNK])
+                                               for s in range(0, n, CHUNK)])
+    kernel_rate = None
+    if nc.HAS_NUMBA:
+        pins = _numba_kernel()
+        out = np.empty((n, 2))
+        pins(th[:10], out[:10])  # compile
+        kernel_rate = n / _best_of(repeat, lambda: pins(th, out))
+        if np.max(np.abs(out[:CHUNK] - ref)) > 1e-9:
+            raise AssertionError("the compiled closed form does not match mechc's")
     return PeerResult(mechc_rate, step_rate, fast_rate,
-                      "numba" if nc.HAS_NUMBA else "python", diff, n)
+                      "numba" if nc.HAS_NUMBA else "python", diff, n, bare_rate, kernel_rate)
+
+
+def _best_of(repeat: int, fn) -> float:
+    best = math.inf
+    for _ in range(repeat):
+        t0 = time.process_time()
+        fn()
+        best = min(best, time.process_time() - t0)
+    return best

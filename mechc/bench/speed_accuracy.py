@@ -495,13 +495,23 @@ def peers(b: Bench, c: Circuit) -> None:
               f"Linkage.step {r.pylinkage_step_per_s:,.0f}/s, step_fast ({r.pylinkage_backend}) "
               f"{fast or float('nan'):,.0f}/s; rocker pins agree to "
               f"{r.max_difference_mm:.1e} mm")
+        kernel = r.numba_kernel_per_s
+        b.say(f"floors on the same four-bar, positions only (no angle, transmission, flags or "
+              f"closure check): numpy {r.bare_numpy_per_s:,.0f}/s = "
+              f"{r.bare_numpy_per_s / best_peer:.2f}x pylinkage's best; compiled scalar loop "
+              + (f"{kernel:,.0f}/s = {kernel / best_peer:.2f}x" if kernel else "n/a (no numba)"))
         b.summary["kinematic_vs_pylinkage"] = round(r.mechc_per_s / best_peer, 3)
+        b.summary["positions_only_numpy_vs_pylinkage"] = round(r.bare_numpy_per_s / best_peer, 3)
+        if kernel:
+            b.summary["positions_only_compiled_vs_pylinkage"] = round(kernel / best_peer, 3)
         b.summary["kinematic_vs_pylinkage_step"] = round(r.mechc_per_s / r.pylinkage_step_per_s,
                                                          2)
         b.summary["pylinkage_backend"] = r.pylinkage_backend
         b.summary["fourbar_positions_per_s"] = round(r.mechc_per_s)
         for lvl, rate in (("mechc", r.mechc_per_s), ("pylinkage step", r.pylinkage_step_per_s),
-                          ("pylinkage step_fast", fast)):
+                          ("pylinkage step_fast", fast),
+                          ("positions only, numpy", r.bare_numpy_per_s),
+                          ("positions only, compiled", kernel)):
             b.row(section="fourbar", circuit="four-bar", level=lvl, cases=r.positions,
                   seconds=(r.positions / rate) if rate else "",
                   error_fraction=r.max_difference_mm)
