@@ -17,6 +17,10 @@ about its slider friction, the output force comes from the motor.
 Kinematic model (quasi-static): T rests on the stop its input state selects (off below half
 stroke, on from half stroke), the output slider follows the crank closed form, F1/F2 follow the
 slider until their wedge stops them. The switching itself is only in the dynamic model.
+
+Dynamic model: the wedge is a one-way roller clutch, and pymunk cannot find its lock on its own
+(see ``_add_wedge_clutches``), so each wedge also gets a ratchet that holds T at the roller-matched
+speed while its F touches both R and C.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pymunk
 from scipy.optimize import brentq
 
 from mechc.cell import Cell
@@ -146,6 +151,88 @@ def _disc(c: Point, r: float, n: int = 16) -> list[Point]:
 
 
 STOP_ERROR_BIAS = 0.1 ** 60  # pymunk: fraction of a joint error left after 1 s
+#: The wedge clutch's torque limit as a multiple of the torque T must hold on a stop. It stands
+#: for the roller drive's stall torque (a self-locking wedge has no friction limit of its own):
+#: enough to bring T and its loads to the roller speed within a millisecond or so, finite so an
+#: output blocked by its loads still stalls visibly.
+CLUTCH_TORQUE = 10.0
+CLUTCH_RATCHET = 1e-6  # rad: the ratchet's notch, a stand-in for a continuous one-way clutch
+CLUTCH_MAX_BIAS = 1e-3  # rad/s: the ratchet corrects a lag by speed, not by a position jump
+
+
+@dataclass
+class _Clutch:
+    """One wedge's clutch: engaged while F has contacts with both R and C (arbiter counts)."""
+
+    ratchet: pymunk.RatchetJoint
+    drive: pymunk.Body
+    toggle: pymunk.Body
+    torque: float  # pymunk units
+    touching: dict[str, int]
+
+    def begin(self, arbiter, space, key: str) -> None:
+        self.touching[key] += 1
+        if all(self.touching.values()) and self.ratchet.max_force == 0.0:
+            # engage from T's present angle: no lag carried over from the last engagement
+            self.ratchet.angle = self.toggle.angle - self.drive.angle
+            self.ratchet.max_force = self.torque
+
+    def separate(self, arbiter, space, key: str) -> None:
+        self.touching[key] -= 1
+        if not all(self.touching.values()):
+            self.ratchet.max_force = 0.0
+
+
+def _add_wedge_clutches(scene, part: Part, t_id: str) -> list[_Clutch]:
+    """Make each wedge lock as a real one does.
+
+    F between R and C is a roller freewheel: with mu > tan(beta), tan(gamma) it cannot slip, so
+    while F touches both, C's surface moves with R's (T at ``speed * r_r / rc``) unless T runs
+    ahead, when the wedge opens. Rigid contacts with Coulomb friction have no finite solution
+    while F slips on C in such a wedge (the frictions draw F in harder than the normals push it
+    out, Painlevé's paradox); pymunk's solver then raises the contact forces only by about F's
+    momentum per iteration, and F rolls into the wedge at half R's surface speed while T is slowly
+    brought up. Measured (seed-204 flow table, AMPLIFIER a4): F went 0.5 mm past the wedge point
+    in 3 ms, overlapping R by 0.26 mm, and reached its slot end; the slot end then carried the
+    wedge's pull, the contact forces fell to ~0 and T fell back to its stop. A real wedge locks
+    within its contacts' elastic deflection (~1 um at 40 N for aluminium rollers 3 mm wide).
+
+    So each wedge gets a ratchet from T to a kinematic body turning at the roller-matched speed:
+    T may not lag it, may run ahead. It is switched on only while F's contacts with R and C both
+    exist (pymunk begin/separate events: no Python per step), so it drives exactly when the
+    wedge is closed: not before F arrives, not over the relief, not after the input leaves."""
+    d = part.data["design"]
+    omega = d["speed"] * d["r_r"] / d["rc"]
+    if omega <= 0.0:  # rollers at rest, or turning so that they draw F out: no wedge closes
+        return []
+    from mechc.mech.dynamics import N
+
+    toggle = scene.bodies[t_id]
+    rollers = [b.id for b in part.bodies if b.role == "friction roller"]
+    powered = [b.id for b in part.bodies if b.role == "powered roller"]
+    touches = {(j.a, j.b): (i, shapes) for i, (j, shapes) in enumerate(scene.touches)}
+    out = []
+    # (F1, R1) turn T counter-clockwise to on, (F2, R2) clockwise to off (synthesise's order)
+    for f_id, r_id, sense in ((rollers[0], powered[0], 1.0), (rollers[1], powered[1], -1.0)):
+        drive = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        drive.position = toggle.position
+        drive.angular_velocity = sense * omega
+        ratchet = pymunk.RatchetJoint(drive, toggle, 0.0, sense * CLUTCH_RATCHET)
+        ratchet.max_force = 0.0
+        ratchet.max_bias = CLUTCH_MAX_BIAS
+        scene.space.add(drive, ratchet)
+        clutch = _Clutch(ratchet, drive, toggle, CLUTCH_TORQUE * d["hold_required"] * N,
+                         {"R": 0, "C": 0})
+        for key, surface in (("R", r_id), ("C", t_id)):
+            i, shapes = touches[(surface, f_id)]
+            kind_surface, kind_roller = 2 * i + 2, 2 * i + 3  # unique per touch in the scene
+            for sh in shapes[:-1]:
+                sh.collision_type = kind_surface
+            shapes[-1].collision_type = kind_roller
+            scene.space.on_collision(kind_surface, kind_roller, begin=clutch.begin,
+                                     separate=clutch.separate, data=key)
+        out.append(clutch)
+    return out
 
 
 class Amplifier(Cell):
@@ -266,7 +353,7 @@ class Amplifier(Cell):
     @classmethod
     def build_dynamics(cls, scene, part: Part) -> None:
         """pymunk multiplies the two shapes' friction coefficients: make the roller's 1 so a
-        touch's contact has the friction its joint says."""
+        touch's contact has the friction its joint says; T's stops stiff; the wedges lock."""
         mine = {j.id for j in part.joints if j.kind == "touch"}
         for j, shapes in scene.touches:
             if j.id in mine:
@@ -278,6 +365,7 @@ class Amplifier(Cell):
         for c in scene.space.constraints:
             if tb in (c.a, c.b):
                 c.error_bias = STOP_ERROR_BIAS
+        _add_wedge_clutches(scene, part, toggle)
 
     @classmethod
     def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):
