@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 import time
@@ -60,6 +61,18 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_INTERNAL
 
 
+def finite_float(text: str) -> float:
+    """An argparse type: a finite number. ``float()`` alone accepts 'nan' and 'inf', which slip
+    through every ``<= 0`` range check and fail much later, deep in a solver."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
+    return v
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="mechc", description=DESCRIPTION,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -99,23 +112,23 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.add_argument("design", metavar="SPEC_OR_JSON")
     s.add_argument("--level", choices=["logic", "kinematic", "dynamic"], default="dynamic",
                    help="simulation level (default: %(default)s)")
-    s.add_argument("--tolerance", type=float, default=0.05, metavar="F",
+    s.add_argument("--tolerance", type=finite_float, default=0.05, metavar="F",
                    help="outputs must sit within F of stroke of their position (default: "
                    "%(default)s)")
     s.add_argument("--cases", type=int, default=16, metavar="N",
                    help="dynamic: seeded random single-input changes after the Gray tour "
                    "(default: %(default)s)")
     s.add_argument("--seed", type=int, default=0, help="seed for the random cases")
-    s.add_argument("--dt", type=float, default=None, metavar="S",
+    s.add_argument("--dt", type=finite_float, default=None, metavar="S",
                    help="dynamic: time step in seconds (default 2.5e-4)")
     s.add_argument("--iterations", type=int, default=None,
                    help="dynamic: solver iterations per step (default 60)")
-    s.add_argument("--move-time", type=float, default=None, metavar="S",
+    s.add_argument("--move-time", type=finite_float, default=None, metavar="S",
                    help="dynamic: seconds an input takes to move (default 0.08)")
     s.add_argument("--prune", action="store_true",
                    help="dynamic: run each input change on a scene of only the cells it can "
                    "move (see docs/performance.md)")
-    s.add_argument("--accuracy", type=float, default=None, metavar="F",
+    s.add_argument("--accuracy", type=finite_float, default=None, metavar="F",
                    help="dynamic: the cheapest settings (from the measured error model) whose "
                    "output error is at most F of stroke, confirmed on the run by step halving")
     s.add_argument("--spec", metavar="OTHER",
@@ -160,7 +173,7 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
                    "choose by itself (e.g. three_bar_and; repeatable)")
     g.add_argument("--fan-in", type=int_at_least(2), default=None, metavar="N",
                    help="at most N inputs per AND/OR/NAND/NOR cell (default: the library's)")
-    g.add_argument("--time-limit", type=float, default=20.0, metavar="S",
+    g.add_argument("--time-limit", type=finite_float, default=20.0, metavar="S",
                    help="seconds per exact-cover program before the best cover found is used "
                    "and reported as not proven minimal (default: %(default)s)")
     g.add_argument("--phase", choices=["auto", "sop"], default="auto",
@@ -176,11 +189,11 @@ def _compile_options(c: argparse.ArgumentParser) -> None:
                    help="build the minimum covers as they are, without consensus terms (outputs "
                    "may then dip during single-input changes)")
     m = c.add_argument_group("mechanism")
-    m.add_argument("--stroke", type=float, default=20.0, metavar="MM",
+    m.add_argument("--stroke", type=finite_float, default=20.0, metavar="MM",
                    help="stroke of every terminal, off to on (default: %(default)s mm)")
-    m.add_argument("--actuator-force", type=float, default=100.0, metavar="N",
+    m.add_argument("--actuator-force", type=finite_float, default=100.0, metavar="N",
                    help="rated force of each input actuator (default: %(default)s N)")
-    m.add_argument("--output-load", type=float, default=0.5, metavar="N",
+    m.add_argument("--output-load", type=finite_float, default=0.5, metavar="N",
                    help="force each circuit output must move either way (default: %(default)s N)")
     m.add_argument("--no-amplify", action="store_true",
                    help="never insert AMPLIFIER cells by itself (by default they go where an "
@@ -241,8 +254,7 @@ def cmd_compile(args) -> int:
     from mechc.writer import design_to_json, dumps, validate, write_atomic
 
     out = args.output or str(Path(args.spec).with_suffix(".json"))
-    if Path(out).resolve() == Path(args.spec).resolve():
-        raise UsageError(f"refusing to overwrite the spec '{args.spec}' with the output")
+    _check_output(out, "output", [("spec", args.spec)])
     t0 = time.perf_counter()
     design = _compile(args.spec, args)
     obj = design_to_json(design, timings=args.timings)
@@ -292,6 +304,25 @@ def cmd_compile(args) -> int:
     return EXIT_OK
 
 
+def _check_output(out: str, what: str, inputs: list[tuple[str, str | None]]) -> None:
+    """Refuse an output path that would overwrite an input or cannot be written, before any
+    work is done (the write itself is atomic: see :func:`mechc.writer.write_atomic`)."""
+    from mechc.writer import check_writable
+
+    for kind, path in inputs:
+        if path and (Path(out).resolve() == Path(path).resolve() or _same_file(out, path)):
+            raise UsageError(f"refusing to overwrite the {kind} '{path}' with the {what}")
+    check_writable(out)
+
+
+def _same_file(a: str, b: str) -> bool:
+    """Also a hard link, which resolve() does not see through."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet)
+        return False
+
+
 def _by_type(d: dict) -> str:
     return ", ".join(f"{v} {k}" for k, v in d.items()) or "none"
 
@@ -317,28 +348,59 @@ def _solver_settings(args, design):
                      if design.mechanism else 0.1)
     for opt in SOLVER_OPTIONS:
         v = getattr(args, opt)
-        if v is not None:
-            if v <= 0:
-                raise UsageError(f"--{opt.replace('_', '-')} must be positive")
+        if v is not None:  # checked positive by _check_simulate_options
             setattr(st, opt, v)
     return st
+
+
+def _check_simulate_options(args) -> None:
+    """Every option range, before any file is read or any proof started."""
+    if not 0 < args.tolerance < 0.5:
+        raise UsageError("--tolerance must be between 0 and 0.5")
+    if args.cases < 0:
+        raise UsageError("--cases must not be negative")
+    for opt in SOLVER_OPTIONS:
+        v = getattr(args, opt)
+        if v is not None and v <= 0:
+            raise UsageError(f"--{opt.replace('_', '-')} must be positive")
+    if args.accuracy is not None:
+        if not 0 < args.accuracy < 0.5:
+            raise UsageError("--accuracy must be between 0 and 0.5 (fraction of stroke)")
+        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
+            raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
+    if args.report:  # before a proof that may take minutes, not after it
+        _check_output(args.report, "report", [("design", args.design), ("spec", args.spec)])
 
 
 def cmd_simulate(args) -> int:
     from mechc.library import load_library
     from mechc.writer import dumps, write_atomic
 
-    if not 0 < args.tolerance < 0.5:
-        raise UsageError("--tolerance must be between 0 and 0.5")
-    if args.cases < 0:
-        raise UsageError("--cases must not be negative")
+    _check_simulate_options(args)
     design = load_design_or_spec(args.design, args)
     spec = _load_spec(args.spec) if args.spec else design.spec
+    lib = load_library(args.cell_dirs)
+    try:
+        report = _prove(args, design, spec, lib)
+    except UsageError as e:  # the options were checked: this is about the design, name it
+        raise UsageError(f"{args.design}: {e}") from None
+    report["design"] = args.design
+    report["spec"] = args.spec or design.spec.path
+    print_report(report, spec)
+    if args.report:
+        write_atomic(args.report, dumps(report))
+    return EXIT_OK if report["passed"] else EXIT_FAILED
+
+
+def _prove(args, design, spec, lib) -> dict:
+    """The proof at ``args.level`` of ``design`` against ``spec``: the report."""
+    from mechc.sim.logic import check_interface
+
     sequential = getattr(spec, "kind", "") == "fsm"
     if not sequential and any(c.type == "MEMORY" for c in design.netlist.cells.values()):
         raise UsageError("a sequential design (with MEMORY cells) is proved against a .fsm spec, "
                          "not a combinational one")
-    lib = load_library(args.cell_dirs)
+    check_interface(design.netlist, spec)  # every level assumes the same pins as the spec
     if args.level == "logic" and sequential:
         from mechc.sim.sequential import prove_sequential
 
@@ -393,8 +455,6 @@ def cmd_simulate(args) -> int:
             if args.accuracy is not None:
                 from mechc.sim.accuracy import prove_with_accuracy
 
-                if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
-                    raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
                 report = prove_with_accuracy(design, spec, lib, args.accuracy,
                                              tolerance=args.tolerance, extra=args.cases,
                                              seed=args.seed, progress=tick,
@@ -405,12 +465,7 @@ def cmd_simulate(args) -> int:
                                        prune=args.prune or PRUNE_DEFAULT)
         finally:
             bar.close()
-    report["design"] = args.design
-    report["spec"] = args.spec or design.spec.path
-    print_report(report, spec)
-    if args.report:
-        write_atomic(args.report, dumps(report))
-    return EXIT_OK if report["passed"] else EXIT_FAILED
+    return report
 
 
 SUMMARY_KEYS = [

@@ -13,6 +13,11 @@ import numpy as np
 
 from mechc.spec.lexer import Token, TokenStream
 
+#: Deepest nesting of '(' and '~' an expression may have. Parsing, evaluation, printing and
+#: minimisation all recurse on the tree; a bound here keeps a pathological spec a located error
+#: instead of a RecursionError deep in the pipeline.
+MAX_NESTING = 64
+
 
 @dataclass(frozen=True)
 class Var:
@@ -49,39 +54,42 @@ Expr = Var | Const | Not | And | Or | Xor
 
 def parse_expr(ts: TokenStream, resolve: Callable[[Token], None]) -> Expr:
     """Parse an expression; ``resolve`` is called on every name (it raises for unknown ones)."""
-    return _parse_or(ts, resolve)
+    return _parse_or(ts, resolve, 0)
 
 
-def _parse_binary(ts, resolve, op, node, sub):
-    args = [sub(ts, resolve)]
+def _parse_binary(ts, resolve, depth, op, node, sub):
+    args = [sub(ts, resolve, depth)]
     while ts.at_op(op):
         ts.advance()
         while ts.cur.kind == "NEWLINE":  # an operator at line end continues the expression
             ts.advance()
-        args.append(sub(ts, resolve))
+        args.append(sub(ts, resolve, depth))
     return args[0] if len(args) == 1 else node(tuple(args))
 
 
-def _parse_or(ts, resolve):
-    return _parse_binary(ts, resolve, "|", Or, _parse_xor)
+def _parse_or(ts, resolve, depth):
+    return _parse_binary(ts, resolve, depth, "|", Or, _parse_xor)
 
 
-def _parse_xor(ts, resolve):
-    return _parse_binary(ts, resolve, "^", Xor, _parse_and)
+def _parse_xor(ts, resolve, depth):
+    return _parse_binary(ts, resolve, depth, "^", Xor, _parse_and)
 
 
-def _parse_and(ts, resolve):
-    return _parse_binary(ts, resolve, "&", And, _parse_unary)
+def _parse_and(ts, resolve, depth):
+    return _parse_binary(ts, resolve, depth, "&", And, _parse_unary)
 
 
-def _parse_unary(ts: TokenStream, resolve) -> Expr:
+def _parse_unary(ts: TokenStream, resolve, depth: int) -> Expr:
     t = ts.cur
+    if t.kind == "OP" and t.text in ("~", "(") and depth >= MAX_NESTING:
+        raise ts.error(f"expression nested more than {MAX_NESTING} levels deep ('(' and '~'); "
+                       "expected a flatter expression")
     if t.kind == "OP" and t.text == "~":
         ts.advance()
-        return Not(_parse_unary(ts, resolve))
+        return Not(_parse_unary(ts, resolve, depth + 1))
     if t.kind == "OP" and t.text == "(":
         ts.advance()
-        e = _parse_or(ts, resolve)
+        e = _parse_or(ts, resolve, depth + 1)
         if not ts.at_op(")"):
             raise ts.error(f"expected ')' to close the '(' at line {t.line} column {t.col}, "
                            f"found {ts.describe()}")

@@ -13,6 +13,14 @@ from pathlib import Path
 from mechc.errors import SpecError
 
 MAX_SPEC_BYTES = 50_000_000
+#: Longest name or number: real ones are a few characters (a column label has one digit per
+#: input, at most 20); a longer token is a mistake, and would be echoed whole in messages.
+MAX_TOKEN_CHARS = 100
+#: Characters other notations use for the operators, with what to write instead.
+_OPERATOR_HINTS = {"+": "'|' for OR", "*": "'&' for AND", ".": "'&' for AND",
+                   "!": "'~' for NOT", "'": "'~' before the name for NOT",
+                   "¬": "'~' for NOT", "∧": "'&' for AND", "∨": "'|' for OR",
+                   "⊕": "'^' for XOR", "·": "'&' for AND"}
 
 
 @dataclass(frozen=True)
@@ -44,6 +52,12 @@ def read_text(path: str | Path) -> str:
     if len(data) > MAX_SPEC_BYTES:
         raise SpecError(str(path), 1, 1, f"file is {len(data)} bytes; the limit is "
                         f"{MAX_SPEC_BYTES}")
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):  # UTF-16 with its BOM (e.g. Windows PowerShell)
+        try:
+            data = data.decode("utf-16").encode("utf-8")
+        except UnicodeDecodeError as e:
+            raise SpecError(str(path), 1, 1, f"invalid UTF-16 text ({e.reason}): expected a "
+                            "text spec in UTF-8 or UTF-16") from None
     nul = data.find(b"\0")
     if nul >= 0:
         line, col = _position(data, nul)
@@ -54,7 +68,14 @@ def read_text(path: str | Path) -> str:
         line, col = _position(data, e.start)
         raise SpecError(str(path), line, col,
                         f"invalid UTF-8 byte 0x{data[e.start]:02x}: expected a text spec") from None
-    return text.lstrip("\ufeff")
+    # every line ending as "\n", so line numbers match an editor's for old-Mac files too
+    return text.lstrip("\ufeff").replace("\r\n", "\n").replace("\r", "\n")
+
+
+def shorten(text: str, limit: int = 40) -> str:
+    """``text`` quoted for a message, cut to ``limit`` characters so one bad token cannot fill
+    the terminal."""
+    return repr(text) if len(text) <= limit else repr(text[:limit]) + "..."
 
 
 def _position(data: bytes, offset: int) -> tuple[int, int]:
@@ -72,9 +93,15 @@ def tokenize(text: str, path: str) -> list[Token]:
         if not m:
             ch = text[pos]
             shown = repr(ch) if ch.isprintable() else f"U+{ord(ch):04X}"
-            raise SpecError(path, line, col, f"unexpected character {shown}")
+            hint = _OPERATOR_HINTS.get(ch)
+            raise SpecError(path, line, col, f"unexpected character {shown}: expected a name, a "
+                            "number or one of ~ & ^ | ( ) = , : - [ ]"
+                            + (f" (write {hint})" if hint else ""))
         kind = m.lastgroup
         s = m.group()
+        if kind in ("name", "number") and len(s) > MAX_TOKEN_CHARS:
+            raise SpecError(path, line, col, f"{kind} {shorten(s)} has {len(s)} characters; "
+                            f"expected at most {MAX_TOKEN_CHARS}")
         if kind == "nl":
             if depth == 0:
                 tokens.append(Token("NEWLINE", "\n", line, col))
@@ -125,7 +152,7 @@ class TokenStream:
             return "end of line" if t.text else "end of file"
         if t.kind == "EOF":
             return "end of file"
-        return repr(t.text)
+        return shorten(t.text)
 
     def expect_op(self, op: str, what: str | None = None) -> Token:
         if self.cur.kind == "OP" and self.cur.text == op:

@@ -13,12 +13,14 @@ import numpy as np
 
 from mechc.errors import SpecError
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, cube_table
-from mechc.spec.lexer import read_text
+from mechc.spec.lexer import read_text, shorten
 from mechc.spec.model import OutputSpec, Spec
 
 TYPES = {"f", "r", "fd", "fr", "dr", "fdr"}
 UNSUPPORTED = {"mv", "kiss", "phase", "pair", "symbolic", "symbolic-output", "label"}
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+#: ASCII digits only: str.isdigit() also accepts '²' (which int() refuses) and '٣' (which it reads).
+_WHOLE = re.compile(r"^[0-9]+$")
 
 
 def parse_pla_file(path: str) -> Spec:
@@ -29,7 +31,8 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
     n = m = None
     ilb = ob = None
     pla_type = "fd"
-    terms: list[tuple[int, int, Cube | None, str]] = []  # (line, col of output part, cube, out)
+    # (line, column of each output character, cube or None for an empty term, output plane)
+    terms: list[tuple[int, tuple[int, ...], Cube | None, str]] = []
     ended = False
     saw_term_line = None
 
@@ -51,7 +54,7 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
             if kw in ("i", "o"):
                 if (n if kw == "i" else m) is not None:
                     raise err(lineno, col0, f"'.{kw}' given twice")
-                if len(args) != 1 or not args[0].isdigit() or len(args[0]) > 6:
+                if len(args) != 1 or not _WHOLE.match(args[0]) or len(args[0]) > 6:
                     raise err(lineno, col0 + len(kw) + 2 if args else col0,
                               f"expected one whole number after '.{kw}'")
                 val = int(args[0])
@@ -74,7 +77,7 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
                 for a in args:
                     if not _NAME_OK.match(a):
                         raise err(lineno, line.find(a) + 1,
-                                  f"name '{a}' is not usable as a signal name "
+                                  f"name {shorten(a)} is not usable as a signal name "
                                   "(letters, digits and '_', not starting with a digit)")
                 if len(set(args)) != len(args):
                     raise err(lineno, col0, f"duplicate name in '.{kw}'")
@@ -83,7 +86,7 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
                 else:
                     ob = args
             elif kw == "p":
-                if len(args) != 1 or not args[0].isdigit():
+                if len(args) != 1 or not _WHOLE.match(args[0]):
                     raise err(lineno, col0, "expected one whole number after '.p'")
             elif kw == "type":
                 if len(args) != 1 or args[0] not in TYPES:
@@ -98,7 +101,8 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
                 raise err(lineno, col0, f"'.{kw}' is not supported by mechc (binary-valued "
                           "PLAs with .i/.o only)")
             else:
-                raise err(lineno, col0, f"unknown keyword '.{kw}'")
+                raise err(lineno, col0, f"unknown keyword {shorten('.' + kw)}: expected one of "
+                          ".i .o .ilb .ob .p .type .e")
             continue
         # a product term
         if n is None or m is None:
@@ -127,7 +131,8 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
                 raise err(lineno, col, f"bad output-plane character {ch!r}: expected "
                           "1 4 0 3 - 2 ~")
         outs = "".join(ch for _, ch in out_chars)
-        terms.append((lineno, out_chars[0][0], None if empty else Cube(mask, value), outs))
+        terms.append((lineno, tuple(c for c, _ in out_chars), None if empty else Cube(mask, value),
+                      outs))
 
     if n is None:
         raise err(1, 1, "empty PLA: expected '.i' (number of inputs)" if not text.strip()
@@ -171,7 +176,7 @@ def _check_on_off(path, n, funcs, terms, outputs) -> None:
             point = Cube.minterm(int(np.flatnonzero(clash)[0]), n)
         else:
             point = None
-        for lineno, col, cube, outs in terms:
+        for lineno, cols, cube, outs in terms:
             if cube is None or outs[j] not in "14":
                 continue
             for lineno2, _c2, cube2, outs2 in terms:
@@ -187,6 +192,6 @@ def _check_on_off(path, n, funcs, terms, outputs) -> None:
                     meet = Cube(cube.mask | cube2.mask, cube.value | cube2.value)
                     if any(d.contains(meet) for d in f.dc):
                         continue
-                raise SpecError(path, lineno, col + j,
+                raise SpecError(path, lineno, cols[j],
                                 f"output '{name}': this on-set term meets the off-set term of "
                                 f"line {lineno2} (at input {meet.to_string(n)})")
