@@ -715,15 +715,14 @@ def register(sub) -> None:
 def cmd_draw(args) -> int:
     import sys
 
-    from mechc.cli import load_design_or_spec
+    from mechc.cli import _check_output, load_design_or_spec
     from mechc.library import load_library
     from mechc.writer import write_atomic
 
     if not math.isfinite(args.scale) or args.scale <= 0:
         raise UsageError(f"--scale must be a positive number of px per mm, got {args.scale:g}")
     out = args.output or str(Path(args.design).with_suffix(".svg"))
-    if Path(out).resolve() == Path(args.design).resolve():
-        raise UsageError(f"refusing to overwrite the input '{args.design}' with the drawing")
+    _check_output(out, "drawing", [("input", args.design)])
     design = load_design_or_spec(args.design, args)
     if design.mechanism is None:
         raise UsageError(f"{args.design}: this design has no mechanism geometry; recompile the "

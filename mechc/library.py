@@ -83,7 +83,9 @@ def load_library(extra_dirs: Iterable[str] = ()) -> Library:
     for d in dirs:
         p = Path(d)
         if not p.is_dir():
-            raise UsageError(f"cell directory '{d}' does not exist")
+            raise UsageError(f"cell directory '{d}' "
+                             + ("is a file, not a directory of cell files" if p.exists()
+                                else "does not exist"))
         for f in sorted(p.glob("*.py")):
             if f.name.startswith("_"):
                 continue

@@ -20,7 +20,7 @@ import numpy as np
 
 from mechc.cell import Cell
 from mechc.mech.build import Builder, Demand, rect
-from mechc.mech.kinematics import Poses, _slider_from_rod
+from mechc.mech.kinematics import KinematicsError, Poses, _slider_from_rod
 from mechc.mech.model import GROUND, Body, Joint, Spring
 
 PUSH = 0.6  # contact travel of an input arm from upright to a stop, in strokes
@@ -147,8 +147,11 @@ class Memory(Cell):
         S = abs(part.terminals["S"].on[0] - part.terminals["S"].off[0])
         us = np.broadcast_to(fixed.get(s_body, np.full(size, -S / 2)), (size,))
         ur = np.broadcast_to(fixed.get(r_body, np.full(size, -S / 2)), (size,))
-        cs = next(j for j in part.joints if j.kind == "contact" and j.a == s_body)
-        cr = next(j for j in part.joints if j.kind == "contact" and j.a == r_body)
+        cs = next((j for j in part.joints if j.kind == "contact" and j.a == s_body), None)
+        cr = next((j for j in part.joints if j.kind == "contact" and j.a == r_body), None)
+        if cs is None or cr is None:
+            raise KinematicsError(f"MEMORY lever {lever.id}: no contact between its "
+                                  f"{'S' if cs is None else 'R'} slider and the lever")
         xo, a = lever.pivot[0], cs.pb[1] - lever.pivot[1]
         sig_s = (cs.pa[0] + us - xo) / a  # sin of the throw the S face imposes (clockwise)
         sig_r = -(cr.pa[0] + ur - xo) / a  # R: upper bound on sin(throw)

@@ -18,10 +18,12 @@ from collections.abc import Callable
 
 import numpy as np
 
+from mechc.errors import UsageError
 from mechc.library import Library
 from mechc.mech.checks import CheckStats
 from mechc.mech.dynamics import DynSettings, Scene
 from mechc.mech.evaluate import output_signals, settle
+from mechc.mech.kinematics import KinematicsError
 from mechc.pipeline import Design
 from mechc.sim.sequential import expected_after, transition_tour
 
@@ -91,6 +93,16 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
                                stats: CheckStats | None = None) -> dict:
     """Walk the closed form through the spec's sequences (each step sampled along the moving
     input, the stateful cells settled at every sample)."""
+    try:
+        return _prove_sequential_kinematic(design, spec, lib, tolerance, samples, seed,
+                                           random_walks, stats)
+    except KinematicsError as e:  # as the combinational kinematic proof reports it
+        raise UsageError(f"the geometry is not a determinate mechanism: {e}") from None
+
+
+def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float,
+                                samples: int, seed: int, random_walks: int,
+                                stats: CheckStats | None) -> dict:
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)
     mems = stateful_cells(design, lib)

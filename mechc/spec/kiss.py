@@ -127,7 +127,8 @@ class _Reader:
         return self._build()
 
     def _count(self, words: list[Word], kw: str, minimum: int) -> int:
-        if len(words) != 2 or not words[1].text.isdigit() or len(words[1].text) > 6:
+        if (len(words) != 2 or not (words[1].text.isascii() and words[1].text.isdigit())
+                or len(words[1].text) > 6):
             w = words[1] if len(words) > 1 else words[0]
             raise self.err(w, f"expected one whole number after '{kw}'")
         v = int(words[1].text)
