@@ -170,3 +170,22 @@ def test_too_many_primes_falls_back_to_expansion_and_stays_correct():
     rows = np.arange(1 << 10)
     care = t != DC
     assert (eval_cover(c.cubes, rows)[care] == (t[care] == 1)).all()
+
+
+def test_wide_complement_is_cubes_not_minterms():
+    """The complement of a two-literal product of 15 inputs (24576 minterms) is the two
+    one-literal cubes: it used to come back as thousands of minterms (espresso's time ran out
+    before EXPAND merged them), and mapping that took minutes and gigabytes."""
+    from mechc.spec.pla import parse_pla
+
+    n = 15
+    spec = parse_pla(f".i {n}\n.o 1\n1-------1------ 1\n.e\n", "wide.pla")
+    eq = minimise(spec)
+    pts = np.arange(1 << n, dtype=np.int64)
+    want = ~(((pts >> (n - 1)) & 1).astype(bool) & ((pts >> (n - 9)) & 1).astype(bool))
+    for cover in (eq.complements["f0"], eq.hazard_free_complements["f0"]):
+        assert len(cover.cubes) == 2
+        got = np.zeros(1 << n, dtype=bool)
+        for c in cover.cubes:
+            got |= (pts & c.mask) == c.value
+        assert np.array_equal(got, want)

@@ -108,6 +108,11 @@ def _expand_pairs(missing, table: np.ndarray, n: int):
     ms, vs = [], []
     for low, bit in missing:
         for m in low.tolist():
+            # a prime found for an earlier pair often holds this one too (a wide function has
+            # thousands of missing pairs and a few primes): expanding each again cost minutes
+            # and gigabytes of duplicate candidates
+            if any(not (mk & bit) and (m & mk) == v for mk, v in zip(ms, vs)):
+                continue
             mask, value = full & ~bit, m & ~bit
             for k in range(n):
                 b = 1 << (n - 1 - k)

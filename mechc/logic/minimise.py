@@ -192,15 +192,19 @@ def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
     from mechc.logic.espresso import espresso
 
     t0 = time.perf_counter()
-    on = [Cube.minterm(int(m), n) for m in np.flatnonzero(table == 1)]
-    dc = [Cube.minterm(int(m), n) for m in np.flatnonzero(table == DC)]
-    if not on:
+    onm = np.flatnonzero(table == 1).astype(np.int64)
+    if not len(onm):
         return Cover([], True, "exact", 0.0), None
+    # espresso starts from cubes, not minterms: greedy primes of the on-set (inside on ∪ dc)
+    # and of the dc-set (inside dc). From 24576 minterms (the complement of a two-literal
+    # product of 15 inputs) its 3 s ran out before EXPAND had merged them, and the mapper
+    # was handed thousands of minterms.
+    on = [Cube(int(m), int(v)) for m, v in zip(*expand_primes(table != 0, onm, n))]
+    dcm = np.flatnonzero(table == DC).astype(np.int64)
+    dc = [Cube(int(m), int(v)) for m, v in zip(*expand_primes(table == DC, dcm, n))]
     res = espresso(n, on, dc, (), 0, time_limit=min(opts.time_limit, opts.alt_time_limit))
     masks = np.array([c.mask for c in res.cubes], dtype=np.int64)
     values = np.array([c.value for c in res.cubes], dtype=np.int64)
-    onm = np.flatnonzero(table == 1).astype(np.int64)
-    dcm = np.flatnonzero(table == DC).astype(np.int64)
     return (Cover(list(res.cubes), False, "espresso", time.perf_counter() - t0),
             (masks, values, onm, dcm))
 
