@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import sys
 import time
@@ -19,7 +18,7 @@ from mechc.errors import (
     SpecError,
     UsageError,
 )
-from mechc.ui import int_at_least, table
+from mechc.ui import finite_float, int_at_least, table
 
 DESCRIPTION = """\
 mechc compiles logic into mechanisms: a Boolean or sequential specification becomes a netlist of
@@ -59,18 +58,6 @@ def main(argv: list[str] | None = None) -> int:
         print(f"mechc: internal error: {type(e).__name__}: {e} (set MECHC_DEBUG=1 for a "
               "traceback, and please report it)", file=sys.stderr)
         return EXIT_INTERNAL
-
-
-def finite_float(text: str) -> float:
-    """An argparse type: a finite number. ``float()`` alone accepts 'nan' and 'inf', which slip
-    through every ``<= 0`` range check and fail much later, deep in a solver."""
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
-    if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
-    return v
 
 
 def build_parser() -> argparse.ArgumentParser:

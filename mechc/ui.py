@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from collections.abc import Sequence
@@ -72,6 +73,18 @@ def _fmt(v: object) -> str:
     if isinstance(v, float):
         return f"{v:.4g}"
     return str(v)
+
+
+def finite_float(text: str) -> float:
+    """An argparse type: a finite number. ``float()`` alone accepts 'nan' and 'inf', which slip
+    through every ``<= 0`` range check and fail much later, deep in a solver."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
+    return v
 
 
 def int_at_least(lo: int):

@@ -14,7 +14,7 @@ import textwrap
 import numpy as np
 
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
-from mechc.ui import int_at_least
+from mechc.ui import finite_float, int_at_least
 
 SYNTH_DESCRIPTION = """\
 Dimensional synthesis: find link lengths and pivots.
@@ -70,7 +70,7 @@ def register(sub) -> None:
                    help="half the distance between the input slides")
     t.add_argument("--stroke", type=_positive, required=True, metavar="MM",
                    help="input travel from false to true")
-    t.add_argument("--output", type=_finite, metavar="MM",
+    t.add_argument("--output", type=finite_float, metavar="MM",
                    help="output joint position (x) in state FF; omitted: the design with the "
                    "largest margin on the checks")
     t.add_argument("--min-angle", type=_angle, default=45.0, metavar="DEG",
@@ -148,32 +148,22 @@ def _common(p) -> None:
 # --- argument types ----------------------------------------------------------------------------
 
 
-def _finite(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
-    if not math.isfinite(v):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got '{text}'")
-    return v
-
-
 def _positive(text: str) -> float:
-    v = _finite(text)
+    v = finite_float(text)
     if v <= 0:
         raise argparse.ArgumentTypeError(f"must be positive, got {text}")
     return v
 
 
 def _angle(text: str) -> float:
-    v = _finite(text)
+    v = finite_float(text)
     if not 0 < v <= 90:
         raise argparse.ArgumentTypeError(f"a transmission angle lies in (0, 90], got {text}")
     return v
 
 
 def _fraction(text: str) -> float:
-    v = _finite(text)
+    v = finite_float(text)
     if not 0 <= v <= 1:
         raise argparse.ArgumentTypeError(f"expected a ratio in [0, 1], got {text}")
     return v
@@ -191,7 +181,7 @@ def _range(text: str) -> tuple[float, float]:
     parts = text.split(":")
     if len(parts) != 2:
         raise argparse.ArgumentTypeError(f"expected 'LO:HI', got '{text}'")
-    lo, hi = (_finite(x) for x in parts)
+    lo, hi = (finite_float(x) for x in parts)
     if not hi > lo:
         raise argparse.ArgumentTypeError(f"expected LO < HI, got '{text}'")
     return lo, hi
