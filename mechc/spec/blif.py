@@ -18,7 +18,7 @@ import numpy as np
 
 from mechc.errors import SpecError
 from mechc.logic.cubes import MAX_TABLE_INPUTS, Cube, input_matrix
-from mechc.spec.lexer import read_text
+from mechc.spec.lexer import Word, read_text
 from mechc.spec.model import OutputSpec, Spec
 
 #: Evaluation is over all 2**n input vectors, so the primary inputs are capped as for .bool.
@@ -34,15 +34,6 @@ UNSUPPORTED = {
     ".exdc": "external don't-care networks (give don't-cares in a .pla or .bool instead)",
     ".start_kiss": "embedded state tables (put the table in a .kiss2 file)",
 }
-
-
-@dataclass(frozen=True)
-class Word:
-    """A word of a logical line and where it is in the file (1-based)."""
-
-    text: str
-    line: int
-    col: int
 
 
 @dataclass

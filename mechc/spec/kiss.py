@@ -25,22 +25,13 @@ from dataclasses import dataclass
 
 from mechc.errors import SpecError
 from mechc.spec.fsm import MAX_FSM_INPUTS
-from mechc.spec.lexer import read_text
+from mechc.spec.lexer import Word, read_text
 from mechc.spec.sequential import FlowTable, SeqSpec, table_problems
 
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _STATE_OK = re.compile(r"^[A-Za-z0-9_]+$")
 ANY = "*"
 KEYWORDS = ("i", "o", "p", "s", "r", "ilb", "ob", "e", "end")
-
-
-@dataclass(frozen=True)
-class Word:
-    """A whitespace-separated word and where it starts (1-based), for error messages."""
-
-    text: str
-    line: int
-    col: int
 
 
 @dataclass

@@ -24,6 +24,16 @@ _OPERATOR_HINTS = {"+": "'|' for OR", "*": "'&' for AND", ".": "'&' for AND",
 
 
 @dataclass(frozen=True)
+class Word:
+    """A whitespace-separated word of a line-oriented format (KISS2, BLIF) and where it starts
+    (1-based), for error messages."""
+
+    text: str
+    line: int
+    col: int
+
+
+@dataclass(frozen=True)
 class Token:
     kind: str  # NAME NUMBER OP NEWLINE EOF
     text: str
