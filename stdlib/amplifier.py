@@ -21,6 +21,13 @@ slider until their wedge stops them. The switching itself is only in the dynamic
 Dynamic model: the wedge is a one-way roller clutch, and pymunk cannot find its lock on its own
 (see ``_add_wedge_clutches``), so each wedge also gets a ratchet that holds T at the roller-matched
 speed while its F touches both R and C.
+
+Landing: past dead centre the toggle spring gives back what the drive put into it, about the hold
+torque times half the swing, and the loads may push the same way; with nothing to take that
+energy T would land on its stop many times faster than the rollers drive it (15x for the loads
+of a 2-bit adder: see docs/amplifier.md). Where that work exceeds ``SNAP_WORK_LIMIT`` a dashpot
+on the output slider, sized from those torques, bounds the landing speed whatever the masses;
+``check_landing`` is the design check.
 """
 
 from __future__ import annotations
@@ -79,6 +86,8 @@ class AmpDesign:
     toggle_damping: float  # damping ratio of T on its toggle spring
     hold_required: float  # N mm, torque T must hold on either stop
     hold_torque: float  # N mm, the toggle spring's torque at the weaker stop
+    load_torque: float = 0.0  # N mm, the most the loads push T with (demand, no margin)
+    dashpot: float = 0.0  # N s/mm, viscous damper on the output slider (0: none)
 
 
 def crank_u(theta, r_o: float, rod: float):
@@ -94,8 +103,89 @@ def toggle_torque(theta, d: AmpDesign):
     return d.toggle_rate * (length - d.toggle_rest) * e * g * np.sin(theta) / length
 
 
+#: Work (N mm) the snap may bring onto a stop per switch without a dashpot: the toggle spring's
+#: energy from dead centre to the stop plus the loads' push over that half swing (independent of
+#: any mass; see ``snap_work``). The dynamic proof passed undamped amplifiers up to 94 N mm
+#: (seed-203 flow table; fan-out 3 at 74 N mm, landing at 3-4.3x the driven speed) and refused
+#: every one from 98 N mm (fan-out 4 ORs: the bars overran their stops) to the 2-bit adder's
+#: force amplifiers (940-1780 N mm: 11-15x, the output slider at 5.4 m/s, contacts overrun by
+#: 1.2 mm). 0.1 J is also the kinetic energy of a 50 g output at 2 m/s.
+SNAP_WORK_LIMIT = 100.0
+#: A fitted dashpot is sized so that T lands on a stop at no more than this multiple of the
+#: speed the rollers drive it at, with the loads pushing it all the way, whatever the masses.
+LANDING_RATIO = 2.0
+#: The design check on a damped amplifier: its landing bound may not exceed this multiple.
+MAX_LANDING_RATIO = 4.0
+
+
+def roller_matched_speed(d: AmpDesign) -> float:
+    """T's speed (rad/s) while a closed wedge drives it: C's surface moves with R's."""
+    return d.speed * d.r_r / d.rc
+
+
+def snap_energy(d: AmpDesign) -> float:
+    """Energy (N mm) the toggle spring gives T from dead centre to the farther stop, from the
+    spring's own energy k (L - L0)^2 / 2 (L = e + g at dead centre)."""
+    e, g = d.toggle_e, d.toggle_g
+
+    def u(theta: float) -> float:
+        length = math.sqrt(e * e + g * g + 2 * e * g * math.cos(theta))
+        return 0.5 * d.toggle_rate * (length - d.toggle_rest) ** 2
+
+    return u(0.0) - min(u(d.theta_on), u(d.theta_off))
+
+
+def snap_work(d: AmpDesign) -> float:
+    """Most work (N mm) that drives T past dead centre onto a stop: the spring's snap energy and
+    the loads pushing with their whole demand over the half swing. Undamped it all arrives at
+    the stop as kinetic energy of T, its output and whatever loads move with them."""
+    return snap_energy(d) + d.load_torque * max(d.theta_on, -d.theta_off)
+
+
+def _max_spring_torque(d: AmpDesign) -> float:
+    thetas = np.linspace(d.theta_off, d.theta_on, 181)
+    return float(np.max(np.abs(toggle_torque(thetas, d))))
+
+
+def landing_speed(d: AmpDesign) -> float:
+    """Upper bound (rad/s) of T's speed as it lands on a stop, for any masses of T, its output
+    and the loads (infinite without a dashpot).
+
+    Where T turns faster than (spring + load torque) / (c arm^2) the dashpot's torque
+    c (w arm) arm exceeds everything that drives T, so T slows: it cannot land faster than
+    that, nor than the rollers drive it (arm: the crank's smallest, at a stop)."""
+    if d.dashpot <= 0.0:
+        return math.inf
+    arm = d.r_o * math.cos(max(d.theta_on, -d.theta_off))
+    terminal = (_max_spring_torque(d) + d.load_torque) / (d.dashpot * arm * arm)
+    return max(roller_matched_speed(d), terminal)
+
+
+def check_landing(d: AmpDesign, where: str = "amplifier") -> None:
+    """The design check: a snap of more than ``SNAP_WORK_LIMIT`` needs a dashpot, and a
+    dashpot must bound the landing to ``MAX_LANDING_RATIO`` x the driven speed."""
+    work, w0 = snap_work(d), roller_matched_speed(d)
+    if d.dashpot <= 0.0:
+        if work > SNAP_WORK_LIMIT:
+            raise DesignError(f"{where}: the toggle's snap brings {work:.4g} N mm onto its stop "
+                              f"(limit {SNAP_WORK_LIMIT:g} N mm without a dashpot): it would "
+                              "slam the output and its loads")
+        return
+    landing = landing_speed(d)
+    if landing > MAX_LANDING_RATIO * w0 * (1 + 1e-9):
+        raise DesignError(f"{where}: its dashpot lets T land on a stop at up to {landing:.4g} "
+                          f"rad/s, {landing / w0:.3g} x its driven speed (limit "
+                          f"{MAX_LANDING_RATIO:g} x)")
+
+
 def design(ctx: SynthContext, demand: Demand, params: dict | None = None) -> AmpDesign:
-    """Dimensions from the stroke, and the toggle spring from what the output must hold."""
+    """Dimensions from the stroke, the toggle spring from what the output must hold, and the
+    dashpot from what the spring and the loads give back past dead centre.
+
+    ``params``: geometry (``beta_deg``, ``coast_deg``, ``gamma_deg``, ``rod``), the drive
+    (``speed``, ``mu``, ``press_N``, ``press_rate``), ``toggle_damping``, ``landing_ratio``
+    (default ``LANDING_RATIO``, used where the snap work exceeds ``SNAP_WORK_LIMIT``; 0 never
+    fits a dashpot, which ``check_landing`` then refuses for a heavy snap)."""
     p = params or {}
     S = ctx.stroke
     beta = math.radians(p.get("beta_deg", 15.0))
@@ -125,10 +215,25 @@ def design(ctx: SynthContext, demand: Demand, params: dict | None = None) -> Amp
                   p.get("speed", 60.0), e, g, rate, rest, p.get("toggle_damping", 0.3),
                   hold_required, 0.0)
     hold = min(float(toggle_torque(theta_on, d)), -float(toggle_torque(theta_off, d)))
-    d = AmpDesign(**{**d.__dict__, "hold_torque": hold})
+    d = AmpDesign(**{**d.__dict__, "hold_torque": hold, "load_torque": need})
     if hold < hold_required * (1 - 1e-9):
         raise DesignError(f"amplifier toggle spring holds {hold:.4g} N mm, needs "
                           f"{hold_required:.4g} N mm")
+    # dashpot: at LANDING_RATIO x the driven speed its torque c (w arm) arm matches the most
+    # the spring and the loads can drive T with (terminal speed; see landing_speed). A light
+    # snap goes without: T then runs ahead of the rollers past dead centre, as Fig. 17 has it
+    ratio = p.get("landing_ratio", LANDING_RATIO)
+    if ratio and snap_work(d) > SNAP_WORK_LIMIT:
+        arm = r_o * min(math.cos(theta_on), math.cos(theta_off))
+        w0 = roller_matched_speed(d)
+        c = (_max_spring_torque(d) + need) / (ratio * w0 * arm * arm)
+        d = AmpDesign(**{**d.__dict__, "dashpot": c})
+        # the rollers drive T through it (the dashpot's torque is largest at dead centre,
+        # arm r_o), against the spring before dead centre and the loads
+        drive = c * w0 * r_o * r_o + _max_spring_torque(d) + need
+        if drive > CLUTCH_TORQUE * hold_required:
+            raise DesignError(f"amplifier rollers must drive T with {drive:.4g} N mm through "
+                              f"its dashpot, more than their {CLUTCH_TORQUE:g} x hold torque")
     return d
 
 
@@ -158,6 +263,23 @@ STOP_ERROR_BIAS = 0.1 ** 60  # pymunk: fraction of a joint error left after 1 s
 CLUTCH_TORQUE = 10.0
 CLUTCH_RATCHET = 1e-6  # rad: the ratchet's notch, a stand-in for a continuous one-way clutch
 CLUTCH_MAX_BIAS = 1e-3  # rad/s: the ratchet corrects a lag by speed, not by a position jump
+
+
+def pymunk_damping(c: float, mass: float, dt: float) -> float:
+    """The coefficient to give a pymunk damped spring so that it removes ``c * v * dt`` of
+    momentum per step, as the dashpot ``c`` does.
+
+    pymunk (Chipmunk) damps a spring's relative speed by the factor exp(-c' dt / m) once per
+    step, m being the mass at the spring's own ends, and then holds the damped speed against the
+    other constraints for the rest of the step. Where something keeps the body moving at v (the
+    roller drive, the loads) that costs m v (exp(c' dt / m) - 1) per step, which equals c v dt
+    for c' = m ln(1 + c dt / m). With c' = c and the amplifier's c dt / m up to ~1.9 (an
+    output slider of 46 g, 0.34 N s/mm, dt 0.25 ms) the model's dashpot was 3x the design's:
+    T crept onto its stop at a third of the designed speed, and the roller drive forcing the
+    output through it stretched the crank rod by 0.2 mm (the proof's limit is 0.1 mm)."""
+    if c <= 0.0 or mass <= 0.0 or not math.isfinite(mass):
+        return c
+    return mass * math.log1p(c * dt / mass) / dt
 
 
 @dataclass
@@ -339,8 +461,11 @@ class Amplifier(Cell):
         out = b.slider("out", x_pin - w / 2, x_pin + 0.8 * S, pin[1], "AMPLIFIER output")
         b.rod(t_id, out.body, pin, (x_pin, pin[1]))
         b.output(out, "Z")
+        check_landing(d, f"amplifier {cid}")
         b.part.data.update({
             "design": {k: float(v) for k, v in d.__dict__.items()},
+            "snap_work_N_mm": round(snap_work(d), 4),
+            "dashpot_N_s_per_mm": round(d.dashpot, 6),
             "rated_output_force_N": round(rated_force(d, ctx), 4),
             "switching_delay_s": MEASURED["switching_delay_s"],
             "fanout_max": MEASURED["fanout_max"],
@@ -353,7 +478,8 @@ class Amplifier(Cell):
     @classmethod
     def build_dynamics(cls, scene, part: Part) -> None:
         """pymunk multiplies the two shapes' friction coefficients: make the roller's 1 so a
-        touch's contact has the friction its joint says; T's stops stiff; the wedges lock."""
+        touch's contact has the friction its joint says; T's stops stiff; the wedges lock; the
+        output slider's dashpot (a pymunk damped spring of zero stiffness along its axis)."""
         mine = {j.id for j in part.joints if j.kind == "touch"}
         for j, shapes in scene.touches:
             if j.id in mine:
@@ -366,6 +492,27 @@ class Amplifier(Cell):
             if tb in (c.a, c.b):
                 c.error_bias = STOP_ERROR_BIAS
         _add_wedge_clutches(scene, part, toggle)
+        c = part.data["design"].get("dashpot", 0.0)
+        if c > 0.0:
+            from mechc.mech.dynamics import FAR, N
+
+            out = next(b.id for b in part.bodies if b.role == "AMPLIFIER output")
+            (rx, ry), (ax, ay) = scene.ref[out], scene.axis[out]
+            body = scene.bodies[out]
+            scene.space.add(pymunk.DampedSpring(scene.space.static_body, body,
+                                                (rx - FAR * ax, ry - FAR * ay), (0.0, 0.0), FAR,
+                                                0.0, pymunk_damping(c * N, body.mass,
+                                                                    scene.settings.dt)))
+            # pymunk solves constraints in the order they were added (Gauss-Seidel), the later
+            # ones best: T's stops and its rod to the output go after the clutch ratchets and
+            # the dashpot (in their own order). Before them, 60 iterations left the rod
+            # stretched by 0.21-0.38 mm while the rollers drove 130-190 N through it into a
+            # 0.36-0.53 N s/mm dashpot (0.02 mm at 240 iterations, < 0.05 mm reordered)
+            for cons in list(scene.space.constraints):
+                if (isinstance(cons, (pymunk.PinJoint, pymunk.SlideJoint))
+                        and tb in (cons.a, cons.b)):
+                    scene.space.remove(cons)
+                    scene.space.add(cons)
 
     @classmethod
     def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):
