@@ -203,12 +203,17 @@ def _paths(o, prefix=()):
             yield from _paths(v, (*prefix, i))
 
 
-@pytest.fixture(scope="module")
-def sorter_design(tmp_path_factory) -> Path:
-    p = tmp_path_factory.mktemp("design") / "sorter.json"
-    code, _, err = run("compile", EXAMPLES / "sorter.bool", "-o", p)
+def _compiled(tmp_path_factory, spec: str) -> Path:
+    """An example compiled once per module (the design the JSON mutations start from)."""
+    p = tmp_path_factory.mktemp("design") / (Path(spec).stem + ".json")
+    code, _, err = run("compile", EXAMPLES / spec, "-o", p)
     assert code == 0, err
     return p
+
+
+@pytest.fixture(scope="module")
+def sorter_design(tmp_path_factory) -> Path:
+    return _compiled(tmp_path_factory, "sorter.bool")
 
 
 # ---- one test per bug class --------------------------------------------------------------------
@@ -469,10 +474,7 @@ def test_design_path_that_is_a_directory(tmp_path):
 # ---- sequential designs with broken geometry (found by the fuzz, fixed outside the parsers) ----
 @pytest.fixture(scope="module")
 def toggle_design(tmp_path_factory) -> Path:
-    p = tmp_path_factory.mktemp("toggle") / "toggle.json"
-    code, _, err = run("compile", EXAMPLES / "toggle.fsm", "-o", p)
-    assert code == 0, err
-    return p
+    return _compiled(tmp_path_factory, "toggle.fsm")
 
 
 def _rewire_rod(d: dict) -> None:
