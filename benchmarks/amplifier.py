@@ -17,12 +17,12 @@ import time
 import numpy as np
 from scipy.optimize import brentq
 
-from mechc.library import load_library
-from mechc.mech.dynamics import DynSettings, Scene, min_jerk
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.cells.library import load_library
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.scene import DynSettings, Scene, min_jerk
 from mechc.pipeline import compile_netlist
-from mechc.sim.dynamic import prove_dynamic
-from mechc.spec.boolfile import parse_bool
+from mechc.proofs.dynamic import prove_dynamic
 
 LIB = load_library()
 

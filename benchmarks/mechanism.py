@@ -17,12 +17,12 @@ import time
 import numpy as np
 
 from mechc.bench.circuits import random_compiled
-from mechc.library import load_library
-from mechc.mech.assemble import MechOptions
-from mechc.mech.evaluate import evaluate
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.passes.assemble import MechOptions
+from mechc.physics.evaluate import evaluate
 from mechc.pipeline import CompileOptions, compile_spec
-from mechc.sim.dynamic import prove_dynamic
-from mechc.spec import load_spec
+from mechc.proofs.dynamic import prove_dynamic
 
 LIB = load_library()
 STRONG = CompileOptions(mech=MechOptions(actuator_force=1e4))  # measure, do not gate on force

@@ -4,7 +4,7 @@
     python benchmarks/minimise.py --mcnc DIR
 
 Random single-output functions, seeded: each of the 2**n rows is off with probability 0.5, on
-with 0.4 and don't-care with 0.1. For each, ``mechc.logic.minimise.minimise`` runs twice: with
+with 0.4 and don't-care with 0.1. For each, ``mechc.passes.minimise.minimise`` runs twice: with
 its default options (which also minimise the complement and look for XOR forms, for the
 mapper) and with ``complements=False`` (the sum of products alone, what SOPform computes). Both
 are timed in this process; SOPform (same minterms and don't-cares) runs in a forked child with
@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
+from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube
-from mechc.logic.minimise import MinimiseOptions, minimise
-from mechc.spec.model import OutputSpec, Spec
+from mechc.passes.minimise import MinimiseOptions, minimise
 
 P_OFF, P_ON, P_DC = 0.5, 0.4, 0.1
 
@@ -175,15 +175,15 @@ def benchmark(sizes: list[int], functions: int, cap: float, seed: int) -> None:
 
 
 def mcnc(directory: str, full: bool) -> None:
+    from mechc.cells.library import load_library
     from mechc.errors import MechcError
-    from mechc.layout import place
-    from mechc.library import load_library
-    from mechc.logic.minimise import MinimiseOptions as Opts
-    from mechc.logic.minimise import minimise as run_minimise
-    from mechc.netlist.mapping import map_equations
+    from mechc.frontends import load_spec
+    from mechc.passes.map import map_equations
+    from mechc.passes.minimise import MinimiseOptions as Opts
+    from mechc.passes.minimise import minimise as run_minimise
+    from mechc.passes.place import place
     from mechc.pipeline import compile_spec
-    from mechc.sim.logic import prove_logic
-    from mechc.spec import load_spec
+    from mechc.proofs.logic import prove_logic
 
     lib = load_library(())
 

@@ -15,11 +15,11 @@ import argparse
 import time
 from pathlib import Path
 
-from mechc.library import load_library
+from mechc.cells.library import load_library
+from mechc.frontends.fsm import parse_fsm_file
 from mechc.pipeline import compile_sequential
-from mechc.sim.seqmech import prove_sequential_dynamic, prove_sequential_kinematic
-from mechc.sim.sequential import prove_sequential
-from mechc.spec.fsm import parse_fsm_file
+from mechc.proofs.seq_logic import prove_sequential
+from mechc.proofs.seq_mechanism import prove_sequential_dynamic, prove_sequential_kinematic
 
 ROOT = Path(__file__).resolve().parents[1]
 

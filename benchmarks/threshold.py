@@ -94,11 +94,12 @@ def cells(xc: np.ndarray, samples: int) -> None:
     """The THRESHOLD cell (stdlib/threshold.py): every generator built as a mechanism (bodies,
     joints, cam profile) and proven through the generic closed forms plus the cam follower;
     the reference is the generator's own closed form on the same states, timed above."""
-    from mechc.mech.build import Demand, SynthContext
-    from mechc.mech.evaluate import signal_of
-    from mechc.netlist.threshold_map import params_of
+    from mechc.stdlib.threshold import ThresholdCell
+
+    from mechc.cells.builder import Demand, SynthContext
+    from mechc.passes.threshold_map import params_of
+    from mechc.physics.evaluate import signal_of
     from mechc.threshold.weights import realise
-    from stdlib.threshold import ThresholdCell
 
     ctx = SynthContext()
     fvs = [fv for fv in range(256) if design_generator(fv, strict=False).kind == "generator"]

@@ -1,3 +1,3 @@
-from mechc.cli import main
+from mechc.cli.main import main
 
 raise SystemExit(main())

@@ -12,13 +12,13 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from mechc.layout import Layout, place
-from mechc.library import Library, load_library
-from mechc.logic.minimise import Equations, MinimiseOptions, minimise
-from mechc.mech.assemble import Mechanism, MechOptions, synthesise_mechanism
-from mechc.netlist.ir import Netlist
-from mechc.netlist.mapping import MapOptions, map_equations
-from mechc.spec.model import Spec
+from mechc.cells.library import Library, load_library
+from mechc.ir.netlist import Netlist
+from mechc.ir.spec import Spec
+from mechc.passes.assemble import Mechanism, MechOptions, synthesise_mechanism
+from mechc.passes.map import MapOptions, map_equations
+from mechc.passes.minimise import Equations, MinimiseOptions, minimise
+from mechc.passes.place import Layout, place
 
 
 @dataclass
@@ -44,7 +44,7 @@ class Design:
     seconds: dict[str, float] = field(default_factory=dict)
     eq: Equations | None = None  # the minimiser's full result (not kept in JSON)
     mechanism: Mechanism | None = None
-    sequential: object | None = None  # SeqEquations of a sequential spec (mechc.logic.flowtable)
+    sequential: object | None = None  # SeqEquations of a sequential spec (mechc.passes.flowtable)
 
 
 def compile_spec(spec: Spec, opts: CompileOptions | None = None,
@@ -88,8 +88,8 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
     inputs + memories (flow-table synthesis when a table is given), mapped with MEMORY cells,
     then place, synthesise, check. ``mechanism=False`` stops after placement (all a logic-level
     proof needs)."""
-    from mechc.logic.flowtable import SynthOptions, derive_equations
-    from mechc.netlist.mapping import map_sequential
+    from mechc.passes.flowtable import SynthOptions, derive_equations
+    from mechc.passes.map import map_sequential
 
     opts = opts or CompileOptions()
     lib = library or load_library(opts.cell_dirs)
@@ -114,7 +114,7 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
     if spec.form == "table" and not spec.table.assign and 0 < v <= MAX_POLARITY_SEARCH:
         # which code of a state variable is "on" is free: each choice swaps SET and RESET and
         # the sign of that variable's literals, so it changes inverters, not literals
-        from mechc.logic.flowtable import synthesise_table
+        from mechc.passes.flowtable import synthesise_table
 
         def parts(m):
             return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values())
@@ -131,8 +131,8 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
         se, mapped = stage("polarity", cheapest, se, mapped)
     nl, amps = mapped.netlist, {}
     if opts.amplify:
-        from mechc.netlist.amplify import snap_outputs
-        from mechc.sim.sequential import outputs_needing_snap
+        from mechc.passes.amplify import snap_outputs
+        from mechc.proofs.seq_logic import outputs_needing_snap
 
         snaps = stage("snap", outputs_needing_snap, nl, spec)
         if snaps:
@@ -170,7 +170,7 @@ def synthesise_powered(nl: Netlist, lib: Library, opts: CompileOptions,
     MEMORY loop whose demand grows every time round), put those nets' loads behind AMPLIFIERs
     and synthesise again. Returns the (possibly amplified) netlist, its layout and mechanism,
     and net -> reason for every net amplified."""
-    from mechc.netlist.amplify import amplify_nets, nets_short_of_force
+    from mechc.passes.amplify import amplify_nets, nets_short_of_force
 
     amps: dict[str, str] = {}
     for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
@@ -205,8 +205,8 @@ def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = 
 def run_design_checks(design: Design, lib: Library) -> None:
     """Measure the design checks on the closed-form kinematics (every input state and every
     single-input change up to 10 inputs) and record them in the mechanism and the stats."""
-    from mechc.mech.checks import CheckStats
-    from mechc.sim.kinematic import sweep
+    from mechc.passes.checks import CheckStats
+    from mechc.proofs.kinematic import sweep
 
     mech = design.mechanism
     stats = CheckStats(mech)
@@ -230,8 +230,8 @@ def run_design_checks(design: Design, lib: Library) -> None:
 def _memory_checks(design: Design, lib: Library, stats) -> list:
     """A sequential design is also walked through every specified transition (the kinematic
     sequential proof): each MEMORY's SET and RESET must never press its lever together."""
-    from mechc.mech.model import Check
-    from mechc.sim.seqmech import prove_sequential_kinematic
+    from mechc.ir.mechanism import Check
+    from mechc.proofs.seq_mechanism import prove_sequential_kinematic
 
     r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)
     per_cell = r["overlaps_by_cell"]

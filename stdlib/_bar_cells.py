@@ -5,8 +5,8 @@ An AND bar's hooks reach below its lowest input, so its output row sits half a p
 than an OR bar's, and the inverting lever under it one pitch lower.
 """
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder, Demand, Sig
+from mechc.cells.builder import Builder, Demand, Sig
+from mechc.cells.cell import Cell
 
 
 def _bar(b: Builder, kind: str):

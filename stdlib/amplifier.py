@@ -39,11 +39,11 @@ import numpy as np
 import pymunk
 from scipy.optimize import brentq
 
-from mechc.cell import Cell
+from mechc.cells.builder import Builder, Demand, SynthContext, rect
+from mechc.cells.cell import Cell
 from mechc.errors import DesignError
-from mechc.mech.build import Builder, Demand, SynthContext, rect
-from mechc.mech.kinematics import solve
-from mechc.mech.model import GROUND, Body, Joint, Part, Point, Spring
+from mechc.ir.mechanism import GROUND, Body, Joint, Part, Point, Spring
+from mechc.physics.closed_form import solve
 
 #: A table computed once by ``python benchmarks/amplifier.py`` (pymunk, default SynthContext
 #: and DynSettings: stroke 20 mm, rollers at 60 rad/s) and re-measured by
@@ -327,7 +327,7 @@ def _add_wedge_clutches(scene, part: Part, t_id: str) -> list[_Clutch]:
     omega = d["speed"] * d["r_r"] / d["rc"]
     if omega <= 0.0:  # rollers at rest, or turning so that they draw F out: no wedge closes
         return []
-    from mechc.mech.dynamics import N
+    from mechc.physics.scene import N
 
     toggle = scene.bodies[t_id]
     rollers = [b.id for b in part.bodies if b.role == "friction roller"]
@@ -494,7 +494,7 @@ class Amplifier(Cell):
         _add_wedge_clutches(scene, part, toggle)
         c = part.data["design"].get("dashpot", 0.0)
         if c > 0.0:
-            from mechc.mech.dynamics import FAR, N
+            from mechc.physics.scene import FAR, N
 
             out = next(b.id for b in part.bodies if b.role == "AMPLIFIER output")
             (rx, ry), (ax, ay) = scene.ref[out], scene.axis[out]

@@ -1,6 +1,6 @@
 """AND: an output bar sprung towards on, held back by every input that is off (001 Figs 5, 16b)."""
 
-from stdlib._bar_cells import BarGate
+from mechc.stdlib._bar_cells import BarGate
 
 
 class AndGate(BarGate):

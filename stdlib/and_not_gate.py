@@ -1,6 +1,6 @@
 """AND-NOT (a·b̄): an AND bar whose second input comes through an inverting lever (Fig 16f)."""
 
-from stdlib._bar_cells import InvertedSecondGate
+from mechc.stdlib._bar_cells import InvertedSecondGate
 
 
 class AndNotGate(InvertedSecondGate):

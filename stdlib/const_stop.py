@@ -1,7 +1,7 @@
 """CONST: a terminal held at off or on by a spring against a fixed stop (a constant signal)."""
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder
+from mechc.cells.builder import Builder
+from mechc.cells.cell import Cell
 
 
 class ConstStop(Cell):

@@ -18,10 +18,10 @@ import math
 
 import numpy as np
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder, Demand, rect
-from mechc.mech.kinematics import KinematicsError, Poses, _slider_from_rod
-from mechc.mech.model import GROUND, Body, Joint, Spring
+from mechc.cells.builder import Builder, Demand, rect
+from mechc.cells.cell import Cell
+from mechc.ir.mechanism import GROUND, Body, Joint, Spring
+from mechc.physics.closed_form import KinematicsError, Poses, _slider_from_rod
 
 PUSH = 0.6  # contact travel of an input arm from upright to a stop, in strokes
 CLEAR = 0.1  # gap (strokes) between an input face at off and the lever at its far stop

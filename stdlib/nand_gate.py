@@ -1,6 +1,6 @@
 """NAND: an AND bar driving an inverting lever on its output (001 Fig 16e)."""
 
-from stdlib._bar_cells import InvertedOutputGate
+from mechc.stdlib._bar_cells import InvertedOutputGate
 
 
 class NandGate(InvertedOutputGate):

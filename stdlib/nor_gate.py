@@ -1,6 +1,6 @@
 """NOR: an OR bar driving an inverting lever on its output (001 Fig 16d)."""
 
-from stdlib._bar_cells import InvertedOutputGate
+from mechc.stdlib._bar_cells import InvertedOutputGate
 
 
 class NorGate(InvertedOutputGate):

@@ -1,7 +1,7 @@
 """NOT: a ternary lever pivoted at its centre; the input moves right, the output left (Fig 16c)."""
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder, Demand
+from mechc.cells.builder import Builder, Demand
+from mechc.cells.cell import Cell
 
 
 class NotLever(Cell):

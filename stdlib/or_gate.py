@@ -1,6 +1,6 @@
 """OR: an output bar with a preloaded return spring; any input pushes it on (001 Figs 4, 16a)."""
 
-from stdlib._bar_cells import BarGate
+from mechc.stdlib._bar_cells import BarGate
 
 
 class OrGate(BarGate):

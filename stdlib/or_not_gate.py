@@ -1,6 +1,6 @@
 """OR-NOT (a + b̄): an OR bar whose second input comes through an inverting lever (Fig 16g)."""
 
-from stdlib._bar_cells import InvertedSecondGate
+from mechc.stdlib._bar_cells import InvertedSecondGate
 
 
 class OrNotGate(InvertedSecondGate):

@@ -2,8 +2,8 @@
 
 Two input links, one from each input slider, meet at a middle joint M; an output link joins M to
 the output slider on the axis between them. The lengths come from
-:mod:`mechc.synthesis.three_bar` (closed form, confirmed numerically), so the output sits at the
-same place for FF, FT and TF and moves one full stroke for TT: an AND gate. Mirrored left to
+:mod:`mechc.linkage_synthesis.three_bar` (closed form, confirmed numerically), so the output sits
+at the same place for FF, FT and TF and moves one full stroke for TT: an AND gate. Mirrored left to
 right, "false" and "true" swap at every terminal and the same linkage is an OR gate (the blog's
 "the linkages are just reversed"), with every terminal still moving +x from off to on.
 
@@ -41,11 +41,11 @@ from functools import lru_cache
 
 import numpy as np
 
-from mechc.cell import Cell
+from mechc.cells.builder import Builder, Demand, SynthContext, rect
+from mechc.cells.cell import Cell
 from mechc.errors import DesignError
-from mechc.mech.build import Builder, Demand, SynthContext, rect
-from mechc.mech.model import Body, Joint, Point
-from mechc.synthesis import three_bar as tb
+from mechc.ir.mechanism import Body, Joint, Point
+from mechc.linkage_synthesis import three_bar as tb
 
 # Geometry as fractions of the stroke (the gate scales exactly). Chosen from a scan of healthy
 # designs (transmission >= 45 deg, link ratio >= 1/3): the least inward wander whose outward

@@ -25,12 +25,12 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from mechc.cell import Cell
+from mechc.cells.builder import Builder, Demand
+from mechc.cells.cell import Cell
 from mechc.errors import DesignError
-from mechc.mech.build import Builder, Demand
-from mechc.mech.kinematics import Poses, solve
-from mechc.mech.model import Body, Joint, Part
-from mechc.netlist.types import evaluate_type
+from mechc.ir.logic_types import evaluate_type
+from mechc.ir.mechanism import Body, Joint, Part
+from mechc.physics.closed_form import Poses, solve
 from mechc.threshold.cam import Follower, FollowerProgram
 from mechc.threshold.functions import input_matrix
 from mechc.threshold.generator import GeneratorDesign, design_generator

@@ -1,8 +1,9 @@
 """XNOR (coincidence): the XOR cell's OR bar driving an inverting lever (001 §2.3.7)."""
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder, Demand, Sig
-from stdlib.xor_gate import build_xor
+from mechc.stdlib.xor_gate import build_xor
+
+from mechc.cells.builder import Builder, Demand, Sig
+from mechc.cells.cell import Cell
 
 
 class XnorGate(Cell):

@@ -5,8 +5,8 @@ function from the Chapter II blocks: each input holds back one AND bar directly 
 through its own inverting lever, and an OR bar takes either AND bar.
 """
 
-from mechc.cell import Cell
-from mechc.mech.build import Builder, Demand
+from mechc.cells.builder import Builder, Demand
+from mechc.cells.cell import Cell
 
 
 def build_xor(b: Builder, demand: Demand):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from mechc.cli import main
+from mechc.cli.main import main
 
 
 @pytest.fixture

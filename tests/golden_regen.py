@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
+from mechc.frontends import load_spec
 from mechc.pipeline import compile_spec
-from mechc.spec import load_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 for name in ["sorter", "full_adder", "comparator2", "sevenseg"]:

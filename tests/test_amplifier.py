@@ -7,19 +7,19 @@ import math
 
 import numpy as np
 import pytest
+from mechc.stdlib.amplifier import MEASURED, design, toggle_torque
 from scipy.optimize import brentq
 
-from mechc.library import load_library
-from mechc.mech.build import Demand, SynthContext
-from mechc.mech.dynamics import DynSettings, Scene
-from mechc.mech.kinematics import solve
-from mechc.mech.model import Part
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.cells.builder import Demand, SynthContext
+from mechc.cells.library import load_library
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.mechanism import Part
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.closed_form import solve
+from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_netlist
-from mechc.sim.dynamic import prove_dynamic
-from mechc.sim.kinematic import prove_kinematic
-from mechc.spec.boolfile import parse_bool
-from stdlib.amplifier import MEASURED, design, toggle_torque
+from mechc.proofs.dynamic import prove_dynamic
+from mechc.proofs.kinematic import prove_kinematic
 
 LIB = load_library()
 CTX = SynthContext()
@@ -139,7 +139,7 @@ def _input_and_output_impulse(sc, target):
     tb = sc.bodies["amp.T"]
     rod = next(c for c in sc.space.constraints if isinstance(c, pymunk.PinJoint)
                and tb in (c.a, c.b))
-    from mechc.mech.dynamics import min_jerk
+    from mechc.physics.scene import min_jerk
 
     s0 = servo.position
     f_in, f_out = [], []
@@ -185,7 +185,7 @@ def test_switching_delay_is_measured_and_bounded_by_the_idler_speed():
     dd = d.mechanism.cells["c1"].data["design"]
     omega_max = abs(dd["speed"]) * dd["r_r"] / dd["rc"]
     tb = sc.bodies["c1.T"]
-    from mechc.mech.dynamics import min_jerk
+    from mechc.physics.scene import min_jerk
 
     t_in = sc.settings.move_time * brentq(lambda x: float(min_jerk(x)) - 0.95, 0.0, 1.0)
     delays = []

@@ -12,14 +12,14 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from mechc.cells.builder import Demand, SynthContext
+from mechc.cells.library import load_library
 from mechc.errors import DesignError
-from mechc.library import load_library
-from mechc.mech.assemble import MechOptions
-from mechc.mech.build import Demand, SynthContext
-from mechc.mech.dynamics import DynSettings, Scene
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.passes.assemble import MechOptions
+from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import CompileOptions, compile_netlist
-from mechc.spec.boolfile import parse_bool
 
 LIB = load_library()
 CTX = SynthContext()
@@ -70,7 +70,7 @@ def _inertia(part) -> float:
 
 
 def test_landing_check_flags_an_undamped_heavy_amplifier_and_bounds_the_damped_one():
-    from stdlib.amplifier import (
+    from mechc.stdlib.amplifier import (
         LANDING_RATIO,
         SNAP_WORK_LIMIT,
         AmpDesign,

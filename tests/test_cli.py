@@ -177,7 +177,7 @@ def test_cells_lists_the_library(cli):
 
 def test_user_cell_directory_is_picked_up_without_compiler_edits(cli, tmp_path):
     (tmp_path / "my_and.py").write_text(
-        "from stdlib.and_gate import AndGate\n\n\nclass CheapAnd(AndGate):\n"
+        "from mechc.stdlib.and_gate import AndGate\n\n\nclass CheapAnd(AndGate):\n"
         "    name = 'cheap_and'\n    max_inputs = 2\n    description = 'test cell'\n\n"
         "    @classmethod\n    def cost(cls, n):\n        return 1\n")
     code, out, _ = cli("cells", "--cells", tmp_path)
@@ -191,7 +191,7 @@ def test_user_cell_directory_is_picked_up_without_compiler_edits(cli, tmp_path):
 
 def test_user_cell_without_mechanism_is_a_clear_error(cli, tmp_path):
     (tmp_path / "bare.py").write_text(
-        "from mechc.cell import Cell\n\n\nclass Bare(Cell):\n    name = 'bare_and'\n"
+        "from mechc.cells.cell import Cell\n\n\nclass Bare(Cell):\n    name = 'bare_and'\n"
         "    type = 'AND'\n    description = 'no geometry'\n\n    @classmethod\n"
         "    def cost(cls, n):\n        return 0\n")
     spec = tmp_path / "s.bool"

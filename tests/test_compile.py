@@ -150,7 +150,7 @@ def test_constant_and_wire_outputs(cli, tmp_path):
 @pytest.mark.parametrize("path", sorted(EXAMPLES.glob("*.bool")) + sorted(EXAMPLES.glob("*.pla")),
                          ids=lambda p: p.name)
 def test_examples_compile_and_match_their_spec(cli, tmp_path, path):
-    from mechc.spec import load_spec
+    from mechc.frontends import load_spec
 
     out = tmp_path / "x.json"
     assert cli("compile", path, "-o", out)[0] == 0
@@ -166,7 +166,7 @@ def test_examples_compile_and_match_their_spec(cli, tmp_path, path):
 def test_json_has_the_required_keys_and_validates(cli, tmp_path):
     import jsonschema
 
-    from mechc.writer import schema
+    from mechc.backends.design_json import schema
 
     out = tmp_path / "s.json"
     cli("compile", EXAMPLES / "sevenseg.bool", "-o", out)
@@ -239,8 +239,8 @@ def test_print_netlist(cli):
 def test_golden_netlists(name):
     """The canonical text of each example's netlist is pinned; regenerate deliberately with
     `python -m tests.golden_regen` after a reviewed change to minimisation or mapping."""
+    from mechc.frontends import load_spec
     from mechc.pipeline import compile_spec
-    from mechc.spec import load_spec
 
     text = compile_spec(load_spec(EXAMPLES / f"{name}.bool")).netlist.to_text()
     golden = Path(__file__).parent / "golden" / f"{name}.netlist"

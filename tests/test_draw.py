@@ -16,11 +16,11 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from mechc.draw import SCALE_BAR_MM, draw_svg, parse_state
+from mechc.backends.design_json import design_to_json, dumps
+from mechc.backends.svg import SCALE_BAR_MM, draw_svg, parse_state
 from mechc.errors import UsageError
+from mechc.frontends import load_spec
 from mechc.pipeline import compile_spec
-from mechc.spec import load_spec
-from mechc.writer import design_to_json, dumps
 from tests.helpers import EXAMPLES
 
 NS = "{http://www.w3.org/2000/svg}"
@@ -270,7 +270,7 @@ def test_cli_compiles_a_spec(cli, tmp_path):
 def test_unsolved_body_is_shown_and_fails(cli, sorter, sorter_json, tmp_path, monkeypatch):
     """If the solver reports a body it could not pose, the drawing says so (and does not
     claim an output value from it) and the command exits 1."""
-    import mechc.mech.evaluate as ev
+    import mechc.physics.evaluate as ev
 
     owner, pin = sorter.mechanism.outputs["Z"]
     body = sorter.mechanism.owner_part(owner).terminals[pin].body

@@ -20,11 +20,11 @@ from pathlib import Path
 
 import pytest
 
-from mechc.cli import main
+from mechc.cli.main import main
 from mechc.errors import SpecError
-from mechc.spec.boolfile import parse_bool
-from mechc.spec.fsm import parse_fsm
-from mechc.spec.pla import parse_pla
+from mechc.frontends.boolfile import parse_bool
+from mechc.frontends.fsm import parse_fsm
+from mechc.frontends.pla import parse_pla
 from tests.helpers import EXAMPLES
 
 SENTINEL = b"precious\n"
@@ -383,7 +383,7 @@ def test_failed_write_is_exit_2_and_leaves_the_old_file(tmp_path, monkeypatch):
     def full(*_a, **_k):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr("mechc.writer.os.replace", full)
+    monkeypatch.setattr("mechc.backends.design_json.os.replace", full)
     code, _, err = run("compile", EXAMPLES / "sorter.bool", "-o", out)
     assert_user_error(code, err, out, located=False)
     assert f"{out}: cannot write: {os.strerror(errno.ENOSPC)}" in err

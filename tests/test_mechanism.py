@@ -11,15 +11,15 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from mechc.library import load_library
-from mechc.mech.build import Demand, SynthContext
-from mechc.mech.kinematics import position, solve
+from mechc.backends.design_json import design_from_json, design_to_json
+from mechc.cells.builder import Demand, SynthContext
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.frontends.boolfile import parse_bool
+from mechc.physics.closed_form import position, solve
 from mechc.pipeline import compile_spec
-from mechc.sim.dynamic import prove_dynamic
-from mechc.sim.kinematic import prove_kinematic
-from mechc.spec import load_spec
-from mechc.spec.boolfile import parse_bool
-from mechc.writer import design_from_json, design_to_json
+from mechc.proofs.dynamic import prove_dynamic
+from mechc.proofs.kinematic import prove_kinematic
 from tests.helpers import EXAMPLES
 
 CTX = SynthContext()
@@ -102,7 +102,7 @@ def test_not_lever_matches_loop_closure_solved_numerically():
 @pytest.mark.parametrize("name", ["or", "and", "not", "nor", "nand", "and_not", "or_not", "xor",
                                   "xnor"])
 def test_each_cell_realises_its_type_at_the_ends_of_its_stroke(name):
-    from mechc.netlist.types import evaluate_type
+    from mechc.ir.logic_types import evaluate_type
 
     cls = LIB[name]
     n = cls.min_inputs
@@ -119,7 +119,7 @@ def test_each_cell_realises_its_type_at_the_ends_of_its_stroke(name):
 def test_rods_between_cells_carry_the_signal_unchanged():
     d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
     mech = d.mechanism
-    from mechc.mech.evaluate import evaluate
+    from mechc.physics.evaluate import evaluate
 
     vals = {k: np.linspace(0, 1, 9) for k in d.netlist.inputs}
     poses = evaluate(mech, LIB, {c.id: c.cell for c in d.netlist.cells.values()}, vals)
@@ -141,7 +141,7 @@ CELL_SPECS = {
 
 def single_cell(name: str):
     """A design of exactly one library cell between input sliders and the output."""
-    from mechc.netlist.ir import CellInst, Netlist
+    from mechc.ir.netlist import CellInst, Netlist
     from mechc.pipeline import compile_netlist
 
     cls = LIB[name]
@@ -247,7 +247,7 @@ def test_geometry_perturbation_is_caught():
 
 
 def test_too_large_time_step_is_reported_not_passed():
-    from mechc.mech.dynamics import DynSettings
+    from mechc.physics.scene import DynSettings
 
     d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
     r = prove_dynamic(d, d.spec, LIB, DynSettings(dt=0.01, iterations=2), extra=0)
@@ -260,7 +260,7 @@ def test_too_large_time_step_is_reported_not_passed():
 def test_overloaded_actuator_stalls_and_is_reported():
     """An input actuator rated far below what its loads need cannot move them: the proof fails
     (stall, or outputs not where the spec wants them), it is never passed."""
-    from mechc.mech.assemble import MechOptions
+    from mechc.passes.assemble import MechOptions
     from mechc.pipeline import CompileOptions
 
     d = compile_spec(load_spec(EXAMPLES / "sorter.bool"),

@@ -8,13 +8,13 @@ import math
 import numpy as np
 import pytest
 
-from mechc.library import load_library
-from mechc.mech.dynamics import DynSettings, Scene
-from mechc.mech.evaluate import evaluate, output_signals
-from mechc.mech.model import GROUND, Spring
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.cells.library import load_library
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.mechanism import GROUND, Spring
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.evaluate import evaluate, output_signals
+from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_netlist
-from mechc.spec.boolfile import parse_bool
 
 LIB = load_library()
 TYPES = {"m1": "memory"}

@@ -9,11 +9,11 @@ import pytest
 import sympy
 from sympy.logic import SOPform
 
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import DC, Cube, eval_cover
-from mechc.logic.minimise import MinimiseOptions, minimise
 from mechc.logic.primes import prime_implicants
-from mechc.spec.boolfile import parse_bool
-from mechc.spec.model import OutputSpec, Spec
+from mechc.passes.minimise import MinimiseOptions, minimise
 from tests.helpers import random_table
 
 
@@ -100,7 +100,7 @@ def test_random_specs_equivalent_and_no_worse_than_sopform(seed):
     eq = minimise(spec, MinimiseOptions(time_limit=4, alt_time_limit=1))
     syms = sympy.symbols(spec.inputs)
     env = dict(zip(spec.inputs, syms))
-    from mechc.spec import expr as ex
+    from mechc.ir import expr as ex
 
     rows = np.arange(1 << n)
     for name, t in tables.items():
@@ -176,7 +176,7 @@ def test_wide_complement_is_cubes_not_minterms():
     """The complement of a two-literal product of 15 inputs (24576 minterms) is the two
     one-literal cubes: it used to come back as thousands of minterms (espresso's time ran out
     before EXPAND merged them), and mapping that took minutes and gigabytes."""
-    from mechc.spec.pla import parse_pla
+    from mechc.frontends.pla import parse_pla
 
     n = 15
     spec = parse_pla(f".i {n}\n.o 1\n1-------1------ 1\n.e\n", "wide.pla")

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from mechc.errors import SpecError
+from mechc.frontends.pla import parse_pla
 from mechc.logic.cubes import DC
-from mechc.spec.pla import parse_pla
 
 
 def table(text, out=0):

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from mechc.errors import SpecError
+from mechc.frontends.boolfile import parse_bool
 from mechc.logic.cubes import DC
-from mechc.spec.boolfile import parse_bool
 
 CORE = """\
 # soap-box sorter

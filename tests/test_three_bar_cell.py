@@ -10,19 +10,7 @@ import math
 
 import numpy as np
 import pytest
-
-from mechc.errors import DesignError, UsageError
-from mechc.library import Library, load_library
-from mechc.mech.build import Builder, Demand, SynthContext
-from mechc.mech.kinematics import position, solve
-from mechc.netlist.ir import CellInst, Netlist
-from mechc.pipeline import compile_netlist
-from mechc.sim.dynamic import prove_dynamic
-from mechc.sim.kinematic import prove_kinematic
-from mechc.sim.logic import prove_logic
-from mechc.spec.boolfile import parse_bool
-from mechc.synthesis import three_bar as tb
-from stdlib.three_bar import (
+from mechc.stdlib.three_bar import (
     OUTPUT_RATIO,
     SEP_RATIO,
     ThreeBarAnd,
@@ -31,6 +19,18 @@ from stdlib.three_bar import (
     input_loads,
     velocity_ratios,
 )
+
+from mechc.cells.builder import Builder, Demand, SynthContext
+from mechc.cells.library import Library, load_library
+from mechc.errors import DesignError, UsageError
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.linkage_synthesis import three_bar as tb
+from mechc.physics.closed_form import position, solve
+from mechc.pipeline import compile_netlist
+from mechc.proofs.dynamic import prove_dynamic
+from mechc.proofs.kinematic import prove_kinematic
+from mechc.proofs.logic import prove_logic
 from tests.helpers import EXAMPLES
 
 CTX = SynthContext()
@@ -239,9 +239,9 @@ def test_cell_alone_dynamic_agrees_with_kinematic(name):
 
 
 def test_not_auto_selected_and_unknown_preference_rejected():
-    from mechc.netlist.mapping import MapOptions
+    from mechc.frontends import load_spec
+    from mechc.passes.map import MapOptions
     from mechc.pipeline import CompileOptions, compile_spec
-    from mechc.spec import load_spec
 
     spec = load_spec(EXAMPLES / "sorter.bool")
     plain = compile_spec(spec)
@@ -253,8 +253,8 @@ def test_not_auto_selected_and_unknown_preference_rejected():
 
 
 def test_sorter_with_three_bar_and_compiles_and_proves(tmp_path):
-    from mechc.cli import main
-    from mechc.writer import design_from_json
+    from mechc.backends.design_json import design_from_json
+    from mechc.cli.main import main
 
     out = tmp_path / "sorter.json"
     assert main(["compile", str(EXAMPLES / "sorter.bool"), "--use-cell", "three_bar_and",

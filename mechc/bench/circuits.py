@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube, input_matrix
-from mechc.netlist.ir import CellInst, Netlist
-from mechc.spec.model import OutputSpec, Spec
 
 TYPES = ["AND", "OR", "NAND", "NOR", "AND_NOT", "OR_NOT", "NOT"]
 CELL_OF = {"AND": "and", "OR": "or", "NAND": "nand", "NOR": "nor", "AND_NOT": "and_not",

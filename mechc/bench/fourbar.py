@@ -3,7 +3,7 @@ comparison of the speed benchmark.
 
 mechc's path is the one every mechanism's kinematic proof takes: a :class:`Part` of two levers
 (crank and rocker, on ground pivots) joined by a rod (the coupler), solved by
-``mechc.mech.kinematics.solve`` with the crank's angle given — the rocker then comes from the
+``mechc.physics.closed_form.solve`` with the crank's angle given — the rocker then comes from the
 rod's circle meeting the rocker's circle (``_lever_from_rod``), vectorised over all crank
 angles at once, with transmission angles, toggle margins and the loop-closure check computed on
 the way, as in a proof; the rocker pin positions are then read with ``position`` (the same
@@ -20,8 +20,8 @@ from functools import lru_cache
 
 import numpy as np
 
-from mechc.mech.kinematics import cos_sin, position, solve
-from mechc.mech.model import Body, Joint, Part
+from mechc.ir.mechanism import Body, Joint, Part
+from mechc.physics.closed_form import cos_sin, position, solve
 
 GROUND_LEN, CRANK, COUPLER, ROCKER = 40.0, 10.0, 40.0, 30.0  # mm: Grashof crank-rocker
 

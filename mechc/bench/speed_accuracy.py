@@ -22,13 +22,13 @@ from pathlib import Path
 import numpy as np
 
 from mechc.bench import stability
-from mechc.library import Library, load_library
-from mechc.mech.dynamics import DynSettings, Scene
+from mechc.cells.library import Library, load_library
+from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import Design, compile_spec
-from mechc.sim.accuracy import MODEL_PATH, ErrorModel, ModelPoint
-from mechc.sim.dynamic import PRUNE_DEFAULT, prove_dynamic
-from mechc.sim.kinematic import prove_kinematic
-from mechc.sim.logic import prove_logic
+from mechc.proofs.accuracy import MODEL_PATH, ErrorModel, ModelPoint
+from mechc.proofs.dynamic import PRUNE_DEFAULT, prove_dynamic
+from mechc.proofs.kinematic import prove_kinematic
+from mechc.proofs.logic import prove_logic
 
 ROOT = Path(__file__).resolve().parents[2]
 _clock = time.process_time  # CPU seconds of this process: the machine is shared, and every
@@ -47,7 +47,7 @@ class Circuit:
     design: Design
     max_cases: int | None = None  # dynamic changes run (None: the proof's own plan)
     note: str = ""
-    sequential: bool = False  # proved by mechc.sim.sequential / seqmech, never pruned
+    sequential: bool = False  # proved by mechc.proofs.seq_logic / seqmech, never pruned
 
 
 @dataclass
@@ -71,16 +71,16 @@ class Bench:
 # ---- circuits ----------------------------------------------------------------------------------
 def circuits(quick: bool, say) -> list[Circuit]:
     from mechc.bench.circuits import random_compiled
-    from mechc.mech.assemble import MechOptions
+    from mechc.frontends import load_spec
+    from mechc.passes.assemble import MechOptions
     from mechc.pipeline import CompileOptions
-    from mechc.spec import load_spec
 
     out = [Circuit("sorter", compile_spec(load_spec(EXAMPLES / "sorter.bool"))),
            Circuit("full_adder", compile_spec(load_spec(EXAMPLES / "full_adder.bool")))]
     fsm = EXAMPLES / "speedctl.fsm"
     if fsm.exists():
         try:
-            from mechc.spec.fsm import parse_fsm_file
+            from mechc.frontends.fsm import parse_fsm_file
 
             d = compile_spec(parse_fsm_file(fsm))
             out.append(Circuit("speedctl", d, sequential=True))
@@ -179,7 +179,7 @@ def levels(b: Bench, cs: list[Circuit]) -> None:
 
 def _logic(c: Circuit) -> dict:
     if c.sequential:
-        from mechc.sim.sequential import prove_sequential
+        from mechc.proofs.seq_logic import prove_sequential
 
         return prove_sequential(c.design.netlist, c.design.spec)
     return prove_logic(c.design.netlist, c.design.spec)
@@ -187,14 +187,14 @@ def _logic(c: Circuit) -> dict:
 
 def _kinematic(b: Bench, c: Circuit) -> dict:
     if c.sequential:
-        from mechc.sim.seqmech import prove_sequential_kinematic
+        from mechc.proofs.seq_mechanism import prove_sequential_kinematic
 
         return prove_sequential_kinematic(c.design, c.design.spec, b.lib)
     return prove_kinematic(c.design, c.design.spec, b.lib)
 
 
 def _sequential_dynamic(b: Bench, c: Circuit, st: DynSettings) -> dict:
-    from mechc.sim.seqmech import prove_sequential_dynamic
+    from mechc.proofs.seq_mechanism import prove_sequential_dynamic
 
     return prove_sequential_dynamic(c.design, c.design.spec, b.lib, st)
 
@@ -337,8 +337,8 @@ def _same_verdict(a: dict, b: dict) -> bool:
 
 def solver_speedup(b: Bench, c: Circuit, cases: int = 4, steps: int = 150) -> float:
     """pymunk's step alone (no measuring), whole scene against each change's pruned scene."""
-    from mechc.sim.dynamic import plan
-    from mechc.sim.prune import build_scene, plan_case
+    from mechc.proofs.dynamic import plan
+    from mechc.proofs.prune import build_scene, plan_case
 
     d, mech = c.design, c.design.mechanism
     names = list(d.spec.inputs)
@@ -441,7 +441,7 @@ def toggle(b: Bench) -> None:
     solver stops returning a pose (it flags; it never clips)."""
     import mpmath
 
-    from mechc.mech.kinematics import solve
+    from mechc.physics.closed_form import solve
 
     part, u_t = stability.toggle_part()
     fr = np.array([0.5, 0.9, 0.99, 0.999, 1 - 1e-4, 1 - 1e-6, 1 - 1e-8, 1 - 1e-10, 1.0,
@@ -669,7 +669,7 @@ def stability_chart(b: Bench, study: dict, path: Path) -> None:
     sel = [(x, y) for x, y in zip(mg, er) if x and np.isfinite(y) and x > 0]
     if sel:
         ax.loglog(*zip(*sel), "o-")
-    from mechc.mech.checks import MIN_SINGULAR_MARGIN_DEG
+    from mechc.passes.checks import MIN_SINGULAR_MARGIN_DEG
 
     ax.axvline(MIN_SINGULAR_MARGIN_DEG, color="r", ls="--", lw=1)
     ax.text(MIN_SINGULAR_MARGIN_DEG, 0.5, " design check:\n reported below", color="r",

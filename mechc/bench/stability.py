@@ -22,7 +22,7 @@ from __future__ import annotations
 import copy
 import math
 
-from mechc.mech.model import Body, Joint, Part
+from mechc.ir.mechanism import Body, Joint, Part
 from mechc.pipeline import Design
 
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechc.threshold.geometry import line_angle_deg, polar
+from mechc.geometry.circles import line_angle_deg, polar
 
 
 def cycloidal(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

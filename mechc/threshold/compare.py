@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechc.geometry.circles import circle_intersection
 from mechc.threshold.cam import Follower, FollowerProgram
-from mechc.threshold.geometry import circle_intersection
 from mechc.threshold.linkage import basic_loop, make_loop, sample_points, threshold_gaps
 from mechc.threshold.seed_tables import (
     PROGRAM_A_THETA7,

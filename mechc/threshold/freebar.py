@@ -17,8 +17,8 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
 
+from mechc.geometry.circles import line_angle_deg, polar
 from mechc.threshold.functions import input_matrix
-from mechc.threshold.geometry import line_angle_deg, polar
 from mechc.threshold.linkage import MAX_LINK, MAX_TURN_DEG, MIN_LINK
 from mechc.threshold.planar import separation, wirings
 from mechc.threshold.separator import input_stroke

@@ -23,7 +23,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
 
-from mechc.threshold.geometry import LoopClosureError, circle_intersection, line_angle_deg
+from mechc.geometry.circles import LoopClosureError, circle_intersection, line_angle_deg
 from mechc.threshold.separator import SeparatorAnalysis, analyse, layout
 
 MIN_LINK = 1.0 / 3.0

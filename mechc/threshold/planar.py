@@ -34,8 +34,8 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
 
+from mechc.geometry.circles import branch_of, line_angle_deg, polar
 from mechc.threshold.functions import input_matrix
-from mechc.threshold.geometry import branch_of, line_angle_deg, polar
 from mechc.threshold.linkage import MAX_LINK, MAX_TURN_DEG, MIN_LINK, ThresholdLoop
 from mechc.threshold.separator import Proportions, SeparatorLayout, input_stroke, layout
 

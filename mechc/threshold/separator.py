@@ -28,7 +28,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.optimize import brentq
 
-from mechc.threshold.geometry import branch_of, circle_intersection, line_angle_deg, polar
+from mechc.geometry.circles import branch_of, circle_intersection, line_angle_deg, polar
 
 #: Limits on extensions used when choosing proportions: F at most l/3 beyond D, E at most l/2
 #: beyond G. The dissertation states no rule; these reproduce its five choices (Fig. 31).

@@ -11,7 +11,7 @@ import pytest
 
 from mechc.logic import espresso as E
 from mechc.logic.cubes import DC, Cube
-from mechc.logic.minimise import MinimiseOptions, _minimise_table
+from mechc.passes.minimise import MinimiseOptions, _minimise_table
 from tests.logic.bruteforce import rand_cubes, spec_table, truth
 
 

@@ -172,10 +172,10 @@ def test_wide_pla_compiles_and_matches_its_cubes(cli, tmp_path, n, m, kind, seed
 @pytest.mark.parametrize("n,seed", [(65, 6), (117, 9)])
 def test_wide_logic_stages_beyond_64_inputs(n, seed):
     """Two- and three-word cubes through parse, minimise, map and the JSON cell list."""
-    from mechc.library import load_library
-    from mechc.logic.minimise import minimise
-    from mechc.netlist.mapping import map_equations
-    from mechc.spec.pla import parse_pla
+    from mechc.cells.library import load_library
+    from mechc.frontends.pla import parse_pla
+    from mechc.passes.map import map_equations
+    from mechc.passes.minimise import minimise
 
     rng = np.random.default_rng(seed)
     text, spec = make_pla(rng, n, 2, "fd")

@@ -9,10 +9,11 @@ import math
 
 import pytest
 
+from mechc.cells.library import load_library
 from mechc.errors import UsageError
-from mechc.library import load_library
+from mechc.frontends import load_spec
 from mechc.pipeline import compile_spec
-from mechc.sim.accuracy import (
+from mechc.proofs.accuracy import (
     ErrorModel,
     ModelPoint,
     choose,
@@ -21,7 +22,6 @@ from mechc.sim.accuracy import (
     load_model,
     prove_with_accuracy,
 )
-from mechc.spec import load_spec
 from tests.helpers import EXAMPLES
 
 LIB = load_library()

@@ -14,8 +14,8 @@ import mpmath
 import numpy as np
 import pytest
 
-from mechc.mech.kinematics import cos_sin, position, solve
-from mechc.mech.model import Body, Joint, Part
+from mechc.ir.mechanism import Body, Joint, Part
+from mechc.physics.closed_form import cos_sin, position, solve
 
 mpmath.mp.dps = 40
 

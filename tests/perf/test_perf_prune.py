@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from mechc.bench.circuits import random_netlist
-from mechc.library import load_library
-from mechc.mech.dynamics import DynSettings, Scene
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_spec
-from mechc.sim.dynamic import plan, prove_dynamic
-from mechc.sim.prune import blocker, cone, plan_case, run_case
-from mechc.spec import load_spec
+from mechc.proofs.dynamic import plan, prove_dynamic
+from mechc.proofs.prune import blocker, cone, plan_case, run_case
 from tests.helpers import EXAMPLES
 
 LIB = load_library()
@@ -133,8 +133,8 @@ def test_frozen_bodies_are_the_ones_the_closed_form_keeps_still(design):
     """Under the default freeze a body is static exactly when the closed form keeps it still
     over the change (brute force: its pose at the 41 samples), or it is a boundary body that
     does not move; kept cells' output terminals stay free."""
-    from mechc.mech.evaluate import evaluate
-    from mechc.sim.prune import SAMPLES, build_scene
+    from mechc.physics.evaluate import evaluate
+    from mechc.proofs.prune import SAMPLES, build_scene
 
     nl, mech = design.netlist, design.mechanism
     types = {c.id: c.cell for c in nl.cells.values()}
@@ -171,7 +171,7 @@ def test_prove_dynamic_pruned_and_whole_agree(design):
 def test_a_spec_mismatch_outside_the_pruned_scene_still_fails():
     """An output the change does not move is not simulated, but its closed-form position is
     still checked against the spec: a flipped minterm fails the pruned proof too."""
-    from mechc.spec.boolfile import parse_bool
+    from mechc.frontends.boolfile import parse_bool
 
     d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
     text = (EXAMPLES / "sorter.bool").read_text()

@@ -15,13 +15,13 @@ import pytest
 from scipy.optimize import brentq
 
 from mechc.bench import stability
-from mechc.library import load_library
-from mechc.mech.checks import MIN_SINGULAR_MARGIN_DEG
-from mechc.mech.dynamics import DynSettings
-from mechc.mech.kinematics import solve
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.passes.checks import MIN_SINGULAR_MARGIN_DEG
+from mechc.physics.closed_form import solve
+from mechc.physics.scene import DynSettings
 from mechc.pipeline import compile_spec
-from mechc.sim.dynamic import prove_dynamic
-from mechc.spec import load_spec
+from mechc.proofs.dynamic import prove_dynamic
 from tests.helpers import EXAMPLES
 
 LIB = load_library()

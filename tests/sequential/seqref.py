@@ -152,7 +152,7 @@ def min_race_free_width(next_: list[list[int | None]], C: int, limit: int = 4) -
 def random_reduced_table(rng, C: int, inputs: int = 2, p: float = 0.9):
     """A random table of C states that are kept apart (each its own row): every column has
     some stable states, and each other state goes to one of them with probability p."""
-    from mechc.spec.sequential import FlowTable
+    from mechc.ir.seqspec import FlowTable
 
     K = 1 << inputs
     nxt = [[None] * K for _ in range(C)]

@@ -2,7 +2,7 @@
 
 In the seed-204 random flow table (7 rows) the AMPLIFIER on memory output y2 did not switch:
 its input arrived at ~600 mm/s, the friction roller F1 rolled 0.5 mm into the wedge instead of
-locking, reached its slot end, and the drive died (details in ``stdlib.amplifier``, function
+locking, reached its slot end, and the drive died (details in ``mechc.stdlib.amplifier``, function
 ``_add_wedge_clutches``). These tests drive a lone amplifier the same way (input at constant
 speed into its end, then held) with the loads a4 had (an OR and an AND-NOT input; one more AND
 for a fan-out of 3) and check the physics of the wedge against closed forms:
@@ -19,11 +19,11 @@ import math
 
 import pytest
 
-from mechc.library import load_library
-from mechc.mech.dynamics import DynSettings, Scene
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.cells.library import load_library
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_netlist
-from mechc.spec.boolfile import parse_bool
 
 LIB = load_library()
 GATES = {"or": ("or", "OR"), "and_not": ("and_not", "AND_NOT"), "and": ("and", "AND")}

@@ -1,4 +1,4 @@
-"""Automatic AMPLIFIERs (mechc.netlist.amplify): where an output must snap, where forces fail.
+"""Automatic AMPLIFIERs (mechc.passes.amplify): where an output must snap, where forces fail.
 
 The ternary prediction of which outputs move partway (``outputs_needing_snap``) is checked
 against an independent method, the kinematic sequential proof of the design built without
@@ -9,15 +9,15 @@ from __future__ import annotations
 
 import pytest
 
-from mechc.library import load_library
-from mechc.mech.assemble import MechOptions
-from mechc.netlist.amplify import fanout_limit
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.frontends.fsm import parse_fsm, parse_fsm_file
+from mechc.passes.amplify import fanout_limit
+from mechc.passes.assemble import MechOptions
 from mechc.pipeline import CompileOptions, compile_sequential, compile_spec
-from mechc.sim.kinematic import prove_kinematic
-from mechc.sim.seqmech import prove_sequential_kinematic
-from mechc.sim.sequential import outputs_needing_snap, prove_sequential
-from mechc.spec import load_spec
-from mechc.spec.fsm import parse_fsm, parse_fsm_file
+from mechc.proofs.kinematic import prove_kinematic
+from mechc.proofs.seq_logic import outputs_needing_snap, prove_sequential
+from mechc.proofs.seq_mechanism import prove_sequential_kinematic
 from tests.helpers import EXAMPLES
 from tests.sequential.test_seq_cli import STARTER
 

@@ -12,11 +12,11 @@ from pathlib import Path
 
 import pytest
 
-from mechc.library import load_library
-from mechc.netlist.amplify import amplify_nets
+from mechc.cells.library import load_library
+from mechc.frontends.fsm import parse_fsm_file
+from mechc.passes.amplify import amplify_nets
 from mechc.pipeline import compile_netlist, compile_sequential
-from mechc.sim.seqmech import prove_sequential_dynamic, prove_sequential_kinematic
-from mechc.spec.fsm import parse_fsm_file
+from mechc.proofs.seq_mechanism import prove_sequential_dynamic, prove_sequential_kinematic
 
 ROOT = Path(__file__).resolve().parents[2]
 WALK = [[{"x1": 0, "x2": 0}, {"x1": 1, "x2": 0}, {"x1": 1, "x2": 1}]]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from mechc.writer import validate
+from mechc.backends.design_json import validate
 from tests.helpers import EXAMPLES
 from tests.sequential.test_seq_synthesis import FOUR_STATE
 

@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-from mechc.library import load_library
+from mechc.cells.library import load_library
+from mechc.frontends.fsm import parse_fsm, parse_fsm_file
 from mechc.pipeline import compile_sequential
-from mechc.sim.seqmech import prove_sequential_kinematic
-from mechc.spec.fsm import parse_fsm, parse_fsm_file
+from mechc.proofs.seq_mechanism import prove_sequential_kinematic
 from tests.helpers import EXAMPLES
 from tests.sequential.test_seq_proof import mutations
 

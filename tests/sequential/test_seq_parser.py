@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from mechc.errors import SpecError
-from mechc.spec.fsm import parse_fsm, parse_fsm_file
-from mechc.spec.sequential import SeqSpec, output_values, stable_graph
+from mechc.frontends.fsm import parse_fsm, parse_fsm_file
+from mechc.ir.seqspec import SeqSpec, output_values, stable_graph
 from tests.helpers import EXAMPLES
 
 # the two cores of issue 4, verbatim

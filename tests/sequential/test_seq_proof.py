@@ -7,12 +7,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mechc.library import load_library
-from mechc.netlist.ir import CellInst, Netlist
+from mechc.cells.library import load_library
+from mechc.frontends.fsm import parse_fsm, parse_fsm_file
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.ir.seqspec import stable_graph
 from mechc.pipeline import compile_sequential
-from mechc.sim.sequential import expected_after, prove_sequential, transition_tour
-from mechc.spec.fsm import parse_fsm, parse_fsm_file
-from mechc.spec.sequential import stable_graph
+from mechc.proofs.seq_logic import expected_after, prove_sequential, transition_tour
 from tests.helpers import EXAMPLES
 
 EXAMPLE_NAMES = ["speedctl", "speedctl_sr", "toggle", "gated_latch", "sequence_detector"]

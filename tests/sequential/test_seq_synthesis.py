@@ -8,15 +8,15 @@ import numpy as np
 import pytest
 
 from mechc.errors import DesignError
-from mechc.logic.flowtable import (
+from mechc.frontends.fsm import parse_fsm, parse_fsm_file
+from mechc.ir.seqspec import SeqSpec, SequentialError, random_flow_table
+from mechc.passes.flowtable import (
     assign_states,
     closed_cover,
     derive_equations,
     reduce_table,
     synthesise_table,
 )
-from mechc.spec.fsm import parse_fsm, parse_fsm_file
-from mechc.spec.sequential import SeqSpec, SequentialError, random_flow_table
 from tests.helpers import EXAMPLES
 from tests.sequential.seqref import (
     EquationMachine,

@@ -9,9 +9,9 @@ import re
 import numpy as np
 import pytest
 
+from mechc.frontends import Spec, load_spec
+from mechc.frontends.blif import parse_blif, table_cover
 from mechc.logic.cubes import DC, Cube
-from mechc.spec import Spec, load_spec
-from mechc.spec.blif import parse_blif, table_cover
 from tests.helpers import EXAMPLES
 
 

@@ -8,10 +8,10 @@ import re
 
 import pytest
 
-from mechc.spec import load_spec
-from mechc.spec.fsm import parse_fsm, parse_fsm_file
-from mechc.spec.kiss import gray_order, parse_kiss, parse_kiss_file
-from mechc.spec.sequential import (
+from mechc.frontends import load_spec
+from mechc.frontends.fsm import parse_fsm, parse_fsm_file
+from mechc.frontends.kiss2 import gray_order, parse_kiss, parse_kiss_file
+from mechc.ir.seqspec import (
     FlowTable,
     SeqSpec,
     allowed_changes,

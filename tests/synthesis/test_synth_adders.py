@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, least_squares
 
-from mechc.synthesis.adders import (
+from mechc.linkage_synthesis.adders import (
     LeverStage,
     LongBarAdder,
     bar_shortening,
@@ -19,7 +19,7 @@ from mechc.synthesis.adders import (
     long_bar_adder,
     structural_error,
 )
-from mechc.synthesis.harmonic import (
+from mechc.linkage_synthesis.harmonic import (
     CrankLinkTransformer,
     best_offset,
     from_homogeneous,

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from mechc.errors import SpecError
-from mechc.synthesis.examples import EXAMPLES
-from mechc.synthesis.positions import format_positions, parse_positions
+from mechc.linkage_synthesis.examples import EXAMPLES
+from mechc.linkage_synthesis.positions import format_positions, parse_positions
 
 FIG4 = """\
 # Figure 4 of Mather & Erdman (2023)

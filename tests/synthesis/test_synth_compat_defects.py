@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mechc.synthesis import mk_circles as mk
-from mechc.synthesis.compatibility import compatibility_linkage, solve_compatibility
-from mechc.synthesis.defects import FourBar, check_dyads, check_loops, loop_signs
-from mechc.synthesis.examples import EXAMPLES
+from mechc.linkage_synthesis import mk_circles as mk
+from mechc.linkage_synthesis.compatibility import compatibility_linkage, solve_compatibility
+from mechc.linkage_synthesis.defects import FourBar, check_dyads, check_loops, loop_signs
+from mechc.linkage_synthesis.examples import EXAMPLES
 
 
 @pytest.mark.parametrize("beta2", [-44.775, -45.508, 30.0])

@@ -10,15 +10,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from mechc.synthesis import mk_circles as mk
-from mechc.synthesis.circles import (
+from mechc.linkage_synthesis import mk_circles as mk
+from mechc.linkage_synthesis.circles import (
     apollonius,
     circumcircle,
     gcircle_to_circle,
     intersect_circles,
     intersect_gcircles,
 )
-from mechc.synthesis.examples import EXAMPLES, printed_residual
+from mechc.linkage_synthesis.examples import EXAMPLES, printed_residual
 
 TOL = 1e-9
 

@@ -8,16 +8,16 @@ from functools import cache
 
 import numpy as np
 import pytest
+from mechc.stdlib.threshold import ThresholdCell, truth_table
 
-from mechc.library import load_library
-from mechc.logic.minimise import minimise
-from mechc.mech.build import Demand, SynthContext
-from mechc.mech.evaluate import signal_of
-from mechc.netlist.mapping import MapOptions, map_equations
-from mechc.netlist.types import evaluate_type
-from mechc.spec.boolfile import parse_bool
+from mechc.cells.builder import Demand, SynthContext
+from mechc.cells.library import load_library
+from mechc.frontends.boolfile import parse_bool
+from mechc.ir.logic_types import evaluate_type
+from mechc.passes.map import MapOptions, map_equations
+from mechc.passes.minimise import minimise
+from mechc.physics.evaluate import signal_of
 from mechc.threshold.functions import input_matrix, truth_table_from_fv
-from stdlib.threshold import ThresholdCell, truth_table
 from tests.threshold.test_threshold_generator import (
     UNAVOIDABLE,
     min_thresholds,
@@ -166,10 +166,10 @@ def test_part_geometry_is_consistent_at_the_design_pose():
 def test_chapter_iii_examples_pass_every_level(example):
     # 001 §3.8: the full adder (sum FV 105, carry FV 23) and FV 157, compiled with
     # --map threshold, proven at the logic, kinematic and dynamic levels
+    from mechc.frontends import load_spec
     from mechc.pipeline import CompileOptions, compile_spec
-    from mechc.sim.dynamic import prove_dynamic
-    from mechc.sim.kinematic import prove_kinematic
-    from mechc.spec import load_spec
+    from mechc.proofs.dynamic import prove_dynamic
+    from mechc.proofs.kinematic import prove_kinematic
     from tests.helpers import EXAMPLES
 
     d = compile_spec(load_spec(EXAMPLES / example),

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from mechc.errors import DesignError
+from mechc.geometry.circles import line_angle_deg
 from mechc.threshold.functions import (
     function_value,
     input_matrix,
@@ -16,7 +17,6 @@ from mechc.threshold.functions import (
     truth_table_from_fv,
 )
 from mechc.threshold.generator import design_generator
-from mechc.threshold.geometry import line_angle_deg
 from mechc.threshold.weights import realise, static_hazards
 
 STROKE = 20.0

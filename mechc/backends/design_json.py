@@ -1,0 +1,304 @@
+"""The output writer: Design <-> JSON (validated against the shipped schema), atomic file writes."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+from mechc import FORMAT_VERSION, __version__
+from mechc.errors import SpecError, UsageError
+from mechc.ir.mechanism import GROUND
+from mechc.ir.netlist import Netlist
+from mechc.ir.spec import Spec
+from mechc.passes.place import Layout, Place
+from mechc.pipeline import Design
+
+
+def design_to_json(d: Design, timings: bool = False) -> dict:
+    nl = d.netlist
+    places = d.layout.cells if d.layout else {}
+    cells = []
+    mech = d.mechanism
+    for c in nl.topo_cells():
+        j = c.to_json()
+        if c.id in places:
+            j["place"] = places[c.id].to_json()
+        if mech is not None and c.id in mech.cells:
+            j["geometry"] = mech.cells[c.id].to_json()
+        cells.append(j)
+    nets = [{"id": k, **v} for k, v in sorted(nl.nets().items(), key=lambda kv: _net_key(kv[0]))]
+    stats = dict(d.stats)
+    if timings:
+        stats["seconds"] = {k: round(v, 6) for k, v in d.seconds.items()}
+    out = {
+        "format": "mechc",
+        "version": FORMAT_VERSION,
+        "generator": f"mechc {__version__}",
+        "inputs": list(nl.inputs),
+        "outputs": dict(nl.outputs),
+        "spec": d.spec.to_json(),
+        "equations": dict(d.equations),
+        "implemented": dict(d.implemented),
+        "cells": cells,
+        "nets": nets,
+        "layout": d.layout.to_json() if d.layout else None,
+        "stats": stats,
+    }
+    if mech is not None:
+        from mechc.backends.mechanism_json import mechanism_json
+
+        out["mechanism"] = mechanism_json(mech)
+    if getattr(d, "sequential", None) is not None:
+        out["sequential"] = d.sequential.to_json()
+    return out
+
+
+def _net_key(name: str):
+    if name.startswith("n") and name[1:].isascii() and name[1:].isdigit():
+        return (1, int(name[1:]), name)
+    return (0, 0, name)
+
+
+def dumps(obj: dict) -> str:
+    return json.dumps(obj, indent=2, ensure_ascii=False) + "\n"
+
+
+def check_writable(path: str | Path) -> None:
+    """Why ``path`` cannot take an output file, as a UsageError (checked before the work that
+    produces the output, so a long run does not end in a write that was never possible)."""
+    p = Path(path)
+    if p.is_dir():
+        raise UsageError(f"{p}: is a directory, expected an output file name")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"{p}: directory '{parent}' does not exist")
+
+
+def write_atomic(path: str | Path, text: str) -> None:
+    """Write via a temporary file in the same directory and rename: a failure leaves any
+    existing file untouched."""
+    p = Path(path)
+    check_writable(p)
+    if p.exists() and not p.is_file():  # a device or pipe (/dev/stdout, /dev/null): no rename
+        try:
+            with open(p, "w", encoding="utf-8") as f:
+                f.write(text)
+        except OSError as e:
+            raise UsageError(f"{p}: cannot write: {e.strerror or e}") from None
+        return
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        if p.exists():
+            os.chmod(tmp, p.stat().st_mode & 0o777)
+        else:
+            os.chmod(tmp, 0o644)
+        os.replace(tmp, p)
+    except BaseException as e:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+        if isinstance(e, OSError):  # permissions, a full disk, a read-only or virtual file system
+            raise UsageError(f"{p}: cannot write: {e.strerror or e}; any existing file is "
+                             "unchanged") from None
+        raise
+
+
+@lru_cache(maxsize=1)
+def schema() -> dict:
+    return json.loads(resources.files("mechc").joinpath("schema/mechc.schema.json").read_text())
+
+
+def validate(obj: dict, where: str) -> None:
+    import jsonschema
+
+    v = jsonschema.Draft202012Validator(schema())
+    errors = sorted(v.iter_errors(obj), key=lambda e: list(e.absolute_path))
+    if errors:
+        e = errors[0]
+        loc = "/".join(str(p) for p in e.absolute_path) or "(top level)"
+        raise UsageError(f"{where}: not a valid mechc design at {loc}: {e.message}")
+
+
+#: Largest magnitude of any number in a design. A coordinate of 1e9 mm is 1000 km: anything
+#: larger is a corrupted file, and it overflows the drawing and the solver (to NaN) later on.
+MAX_MAGNITUDE = 1e9
+
+#: What reading a structurally wrong design raises: a missing key, a list too short, a value of
+#: the wrong type. Caught only around the decoding of the file, never around the work on it.
+DECODE_ERRORS = (KeyError, IndexError, TypeError, ValueError, AttributeError)
+
+
+def load_design_json(path: str | Path) -> dict:
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise UsageError(f"{p}: file not found") from None
+    except IsADirectoryError:
+        raise UsageError(f"{p}: is a directory, expected a design file (.json)") from None
+    except OSError as e:
+        raise UsageError(f"{p}: cannot read design: {e.strerror or e}") from None
+    try:
+        obj = json.loads(data)  # bytes: UTF-8, UTF-16 or UTF-32, as RFC 8259 allows
+    except json.JSONDecodeError as e:
+        raise SpecError(str(p), e.lineno, e.colno, f"invalid JSON: {e.msg}") from None
+    except UnicodeDecodeError as e:
+        raise UsageError(f"{p}: cannot read design: invalid {e.encoding} at byte {e.start}: "
+                         "expected a JSON text") from None
+    except RecursionError:
+        raise UsageError(f"{p}: invalid JSON: nested too deeply") from None
+    if not isinstance(obj, dict) or obj.get("format") != "mechc":
+        raise UsageError(f"{p}: not a mechc design (expected \"format\": \"mechc\")")
+    if obj.get("version") != FORMAT_VERSION:
+        raise UsageError(f"{p}: design format version {obj.get('version')} is not supported "
+                         f"(this mechc reads version {FORMAT_VERSION}); recompile the spec")
+    check_numbers(obj, str(p))
+    validate(obj, str(p))
+    check_references(obj, str(p))
+    return obj
+
+
+def check_numbers(obj, where: str) -> None:
+    """Every number finite and within MAX_MAGNITUDE. Python's json reads NaN, Infinity and
+    1e400 (as inf), and a JSON schema lets NaN through every minimum/maximum."""
+    todo: list[tuple[object, tuple]] = [(obj, ())]
+    while todo:
+        o, path = todo.pop()
+        if isinstance(o, dict):
+            todo.extend((v, (*path, k)) for k, v in o.items())
+        elif isinstance(o, list):
+            todo.extend((v, (*path, i)) for i, v in enumerate(o))
+        elif isinstance(o, float) and not (math.isfinite(o) and abs(o) <= MAX_MAGNITUDE) or \
+                isinstance(o, int) and not isinstance(o, bool) and abs(o) > MAX_MAGNITUDE:
+            loc = "/".join(str(k) for k in path) or "(top level)"
+            raise UsageError(f"{where}: not a valid mechc design at {loc}: {o} is not a finite "
+                             f"number of magnitude at most {MAX_MAGNITUDE:g}")
+
+
+def check_references(obj: dict, where: str) -> None:
+    """What the schema cannot say: every joint, spring and terminal names a body that exists,
+    the mechanism's cell order is the set of cells with geometry, its outputs name a cell or an
+    input with that pin, and the numbers the schema leaves open are in range. A broken reference
+    would otherwise surface as a KeyError deep in a proof or a drawing."""
+    mech = obj.get("mechanism")
+    if not mech:
+        return
+    parts = [((("cells", i, "geometry")), c["geometry"]) for i, c in enumerate(obj["cells"])
+             if "geometry" in c]
+    parts += [(("mechanism", "inputs", k), v) for k, v in mech["inputs"].items()]
+    parts += [(("mechanism", "nets", k), v) for k, v in mech["nets"].items()]
+
+    def bad(path: tuple, what: str) -> UsageError:
+        return UsageError(f"{where}: not a valid mechc design at "
+                          f"{'/'.join(str(k) for k in path)}: {what}")
+
+    bodies: dict[str, tuple] = {}
+    for path, part in parts:
+        for i, b in enumerate(part["bodies"]):
+            if b["id"] in bodies or b["id"] == GROUND:
+                raise bad((*path, "bodies", i, "id"), f"body id {b['id']!r} is used twice")
+            bodies[b["id"]] = path
+
+    def known(path: tuple, name) -> None:
+        if name != GROUND and name not in bodies:
+            raise bad(path, f"{name!r} is not a body of this design (nor {GROUND!r})")
+
+    for path, part in parts:
+        for i, j in enumerate(part["joints"]):
+            here = (*path, "joints", i)
+            for key in ("a", "b", "driven"):
+                if key in j:
+                    known((*here, key), j[key])
+            prof = j.get("profile")
+            if prof is not None and not (isinstance(prof, list) and all(
+                    isinstance(q, list) and len(q) == 2
+                    and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in q)
+                    for q in prof)):
+                raise bad((*here, "profile"), "expected a list of [x, y] points")
+            for key in ("radius_a_mm", "friction"):
+                if key in j and not (isinstance(j[key], (int, float)) and j[key] >= 0):
+                    raise bad((*here, key), f"{j[key]!r}: expected a number >= 0")
+        for i, sp in enumerate(part["springs"]):
+            here = (*path, "springs", i)
+            known((*here, "a"), sp["a"])
+            known((*here, "b"), sp["b"])
+            if sp["rest_length_mm"] < 0:
+                raise bad((*here, "rest_length_mm"), f"{sp['rest_length_mm']}: a length "
+                          "cannot be negative")
+        for k, t in part["terminals"].items():
+            known((*path, "terminals", k, "body"), t["body"])
+    geometry = {c["id"]: c["geometry"] for c in obj["cells"] if "geometry" in c}
+    order = mech["order"]
+    if sorted(order) != sorted(geometry):
+        extra = sorted(set(order) - set(geometry)) or sorted(
+            cid for cid in set(order) if order.count(cid) > 1)
+        missing = sorted(set(geometry) - set(order))
+        raise bad(("mechanism", "order"), "expected each cell with geometry once: "
+                  + (f"{extra[0]!r} is not one or is listed twice" if extra
+                     else f"{missing[0]!r} is missing"))
+    for name, o in mech["outputs"].items():
+        owner, pin = o["owner"], o["pin"]
+        part = geometry.get(owner) or (mech["inputs"].get(owner[3:])
+                                       if owner.startswith("in:") else None)
+        if part is None or pin not in part["terminals"]:
+            raise bad(("mechanism", "outputs", name), f"owner {owner!r} has no terminal {pin!r}")
+
+
+def design_from_json(obj: dict, where: str = "<json>") -> Design:
+    try:
+        spec = _spec_from_json(obj["spec"], where)
+    except DECODE_ERRORS as e:
+        raise UsageError(f"{where}: inconsistent spec echo: {_why(e)}") from None
+    try:
+        nl = Netlist.from_json(obj["inputs"], obj["outputs"], obj["cells"])
+    except DECODE_ERRORS as e:
+        raise UsageError(f"{where}: inconsistent netlist: {_why(e)}") from None
+    layout = None
+    if obj.get("layout"):
+        try:
+            cells = {c["id"]: Place(**c["place"]) for c in obj["cells"] if "place" in c}
+            lj = obj["layout"]
+            layout = Layout(cells, {k: Place(**v) for k, v in lj.get("inputs", {}).items()},
+                            tuple(lj.get("pitch_mm", (0, 0))), lj.get("crossings", 0))
+        except DECODE_ERRORS as e:
+            raise UsageError(f"{where}: inconsistent layout: {_why(e)}") from None
+    mech = None
+    if obj.get("mechanism"):
+        from mechc.backends.mechanism_json import mechanism_from_json
+
+        try:
+            mech = mechanism_from_json(obj["mechanism"], obj["cells"])
+        except DECODE_ERRORS as e:
+            raise UsageError(f"{where}: inconsistent mechanism geometry: {_why(e)}") from None
+    return Design(spec, obj.get("equations", {}), obj.get("implemented", {}), nl, layout,
+                  obj.get("stats", {}), mechanism=mech)
+
+
+def _spec_from_json(d: dict, where: str):
+    if d.get("kind") == "fsm":
+        from mechc.ir.seqspec import SeqSpec, SequentialError
+
+        try:
+            return SeqSpec.from_json(d, where)
+        except SequentialError as e:  # a DesignError (exit 1), but here the file is wrong
+            raise ValueError(str(e)) from None
+    return Spec.from_json(d, where)
+
+
+def _why(e: Exception) -> str:
+    """A decoding error as a phrase: a bare KeyError prints only the quoted key."""
+    if isinstance(e, KeyError):
+        return f"missing or unknown {e.args[0]!r}" if e.args else "missing entry"
+    return str(e) or type(e).__name__

@@ -1,0 +1,288 @@
+"""Building blocks for slider-and-lever cells (001 Chapter II, Figs 4-9 and 16).
+
+A cell is composed from three blocks on horizontal sliders whose displacement is the signal
+(left = off, right = on, every terminal with the same stroke S):
+
+- ``or_bar``: an output bar pushed right by any input through one-sided contacts; a preloaded
+  spring pulls it back to its off stop (OR; Fig. 4, 16a);
+- ``and_bar``: an output bar sprung towards on, held back by hooks on every input (AND; Fig. 5,
+  16b);
+- ``not_lever``: a lever pivoted at its centre between a slot on the signal and a slot on a new
+  slider, so the new slider moves opposite (NOT; Fig. 16c).
+
+Everything is laid out at the design pose (all signals at half stroke). Spring preloads come
+from a force budget: a block is given the force its output must deliver in each direction
+(``Demand``) and reports what it asks of its inputs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from mechc.ir.mechanism import GROUND, Body, Joint, Part, Point, Spring, Terminal
+
+
+@dataclass(frozen=True)
+class Demand:
+    """Force (N) needed to move a signal body towards on (``right``) and towards off (``left``),
+    beyond the body's own guide friction."""
+
+    right: float = 0.0
+    left: float = 0.0
+
+    def __add__(self, o: Demand) -> Demand:
+        return Demand(self.right + o.right, self.left + o.left)
+
+    def reversed(self) -> Demand:
+        return Demand(self.left, self.right)
+
+    def to_json(self) -> dict:
+        return {"right_N": round(self.right, 4), "left_N": round(self.left, 4)}
+
+
+@dataclass(frozen=True)
+class SynthContext:
+    """Design rules shared by all cells (mm, N, kg)."""
+
+    stroke: float = 20.0
+    friction: float = 0.02  # N, guide friction of every slider (Coulomb)
+    margin: float = 1.3  # spring preload >= margin x what it must move
+    min_preload: float = 0.2  # N
+    spring_range: float = 0.3  # k*S / preload: the force rises 30 % over the stroke
+    thickness: float = 3.0  # mm plate
+    density: float = 2.7e-6  # kg/mm^3 (aluminium)
+    damping_ratio: float = 0.4
+    overtravel: float = 0.02  # fraction of stroke a bar may pass its working range (a stop)
+
+    @property
+    def bar(self) -> float:
+        """Width of bars and sliders."""
+        return max(5.0, 0.3 * self.stroke)
+
+    @property
+    def pitch(self) -> float:
+        """Vertical distance between input rows inside a cell."""
+        return max(14.0, 0.9 * self.stroke)
+
+    @property
+    def arm(self) -> float:
+        """Lever arm (pivot to pin): 1.5 S keeps the swing at ±19.5° (transmission ≥ 70°)."""
+        return 1.5 * self.stroke
+
+    def mass(self, polys: list[list[Point]]) -> float:
+        return sum(abs(_area(p)) for p in polys) * self.thickness * self.density
+
+
+def _area(poly: list[Point]) -> float:
+    return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]))
+
+
+def rect(x0: float, y0: float, x1: float, y1: float) -> list[Point]:
+    xa, xb = sorted((x0, x1))
+    ya, yb = sorted((y0, y1))
+    return [(xa, ya), (xb, ya), (xb, yb), (xa, yb)]
+
+
+@dataclass
+class Sig:
+    """A signal inside a cell: a slider whose displacement is the signal, and where it reaches."""
+
+    body: str
+    x: float  # right-most x the body reaches (its tip) at the design pose
+    y: float  # its row
+
+
+class Builder:
+    """Accumulates the bodies, joints and springs of one cell (ids prefixed by the cell id)."""
+
+    def __init__(self, cid: str, ctx: SynthContext):
+        self.cid, self.ctx, self.part = cid, ctx, Part()
+        self.n = 0
+        self.bars: dict[str, tuple[str, int, Point]] = {}  # bar -> (kind, inputs, spring point)
+
+    def name(self, local: str) -> str:
+        return f"{self.cid}.{local}"
+
+    def _id(self, kind: str) -> str:
+        self.n += 1
+        return f"{self.cid}.{kind}{self.n}"
+
+    # ---- bodies -----------------------------------------------------------------------------
+    def slider(self, local: str, x0: float, x1: float, y: float, role: str,
+               layer: int = 0) -> Sig:
+        h = self.ctx.bar
+        poly = rect(x0, y - h / 2, x1, y + h / 2)
+        self.part.bodies.append(Body(self.name(local), "slider", [poly], self.ctx.mass([poly]),
+                                     axis=(1.0, 0.0), layer=layer, role=role))
+        return Sig(self.name(local), x1, y)
+
+    def extend(self, body: str, poly: list[Point]) -> None:
+        b = self.part.body(body)
+        b.outline.append(poly)
+        b.mass = self.ctx.mass(b.outline)
+
+    def reach(self, sig: Sig, x: float) -> Sig:
+        """Lengthen a slider to the right so its tip is at ``x`` (a lug on its row)."""
+        if x > sig.x + 1e-9:
+            h = self.ctx.bar
+            self.extend(sig.body, rect(sig.x, sig.y - h / 2, x, sig.y + h / 2))
+            return Sig(sig.body, x, sig.y)
+        return sig
+
+    def bar(self, local: str, x: float, y_lo: float, y_hi: float, role: str) -> str:
+        w = self.ctx.bar
+        poly = rect(x - w / 2, y_lo - w / 2, x + w / 2, y_hi + w / 2)
+        self.part.bodies.append(Body(self.name(local), "slider", [poly], self.ctx.mass([poly]),
+                                     axis=(1.0, 0.0), layer=1, role=role))
+        return self.name(local)
+
+    # ---- joints -----------------------------------------------------------------------------
+    def contact(self, a: str, b: str, pa: Point, pb: Point, driven: str,
+                normal: Point = (1.0, 0.0)) -> None:
+        self.part.joints.append(Joint(self._id("contact"), "contact", a, b, pa=pa, pb=pb,
+                                      normal=normal, driven=driven))
+
+    def stop_below(self, body: str, at: Point, travel: float) -> None:
+        """The body may move left by at most ``travel`` from the design pose."""
+        ground = (at[0] - travel, at[1])
+        self.part.joints.append(Joint(self._id("stop"), "contact", GROUND, body, pa=ground,
+                                      pb=at, normal=(1.0, 0.0), driven=body))
+
+    def stop_above(self, body: str, at: Point, travel: float) -> None:
+        """The body may move right by at most ``travel`` from the design pose."""
+        ground = (at[0] + travel, at[1])
+        self.part.joints.append(Joint(self._id("stop"), "contact", body, GROUND, pa=at,
+                                      pb=ground, normal=(1.0, 0.0), driven=body))
+
+    def groove(self, slot_body: str, pin_body: str, p0: Point, p1: Point, q: Point) -> None:
+        self.part.joints.append(Joint(self._id("groove"), "groove", slot_body, pin_body,
+                                      p0=p0, p1=p1, q=q))
+
+    def spring(self, body: str, at: Point, direction: int, preload: float, mass: float) -> None:
+        """A tension spring to a ground anchor: ``direction`` -1 pulls the body towards off
+        (lightest at off), +1 towards on (lightest at on). Preload is the force there."""
+        S, c = self.ctx.stroke, self.ctx
+        k = c.spring_range * preload / S
+        rest = S  # the spring's own length at rest
+        # distance at the lightest position gives the preload
+        d_light = rest + preload / k
+        x_light = at[0] + direction * S / 2  # the attachment point at the lightest position
+        anchor = (x_light + direction * d_light, at[1])
+        omega = math.sqrt(k * 1000.0 / max(mass, 1e-6))  # rad/s (k in N/m)
+        damping = 2 * c.damping_ratio * mass * omega / 1000.0  # N s / mm
+        self.part.springs.append(Spring(self._id("spring"), GROUND, body, anchor, at, k, rest,
+                                        damping, preload))
+
+    def terminal(self, pin: str, body: str, point: Point) -> None:
+        S = self.ctx.stroke
+        self.part.terminals[pin] = Terminal(pin, body, "translating",
+                                            (point[0] - S / 2, point[1]),
+                                            (point[0] + S / 2, point[1]))
+
+    # ---- blocks -----------------------------------------------------------------------------
+    def input_slider(self, pin: str, x0: float, y: float, length: float) -> Sig:
+        sig = self.slider(f"in_{pin}", x0, x0 + length, y, f"input {pin}")
+        self.terminal(pin, sig.body, (x0, y))
+        return sig
+
+    def moving_mass(self, bodies: list[str]) -> float:
+        return sum(self.part.body(b).mass for b in bodies)
+
+    def or_bar(self, local: str, sigs: list[Sig], x: float, demand: Demand,
+               y_extra: list[float] = ()) -> tuple[Sig, list[Demand]]:
+        """OR: bar at ``x`` pushed by every signal; returns the bar as a signal and what each
+        input must push (right) / pull (left)."""
+        c, S, w = self.ctx, self.ctx.stroke, self.ctx.bar
+        ys = [s.y for s in sigs] + list(y_extra)
+        y_spring = self.spring_row(ys)
+        bar = self.bar(local, x, min(ys), y_spring, "OR bar")
+        for s in sigs:
+            s2 = self.reach(s, x - w / 2)
+            self.contact(s2.body, bar, (x - w / 2, s.y), (x - w / 2, s.y), driven=bar)
+        y_top = max(ys) + w / 2
+        self.stop_below(bar, (x, y_top), S / 2)  # off position
+        self.stop_above(bar, (x, y_top), S / 2 + c.overtravel * S)  # over-travel
+        self.bars[bar] = ("or", len(sigs), (x - w / 2, y_spring))
+        return Sig(bar, x + w / 2, y_top), self.size(bar, demand)
+
+    def and_bar(self, local: str, sigs: list[Sig], x: float, demand: Demand,
+                y_extra: list[float] = ()) -> tuple[Sig, list[Demand]]:
+        """AND: bar at ``x`` sprung towards on, held back by a hook on every signal."""
+        c, S, w = self.ctx, self.ctx.stroke, self.ctx.bar
+        ys = [s.y for s in sigs] + list(y_extra)
+        y_spring = self.spring_row(ys)
+        bar = self.bar(local, x, min(ys), y_spring, "AND bar")
+        for s in sigs:
+            s2 = self.reach(s, x + w / 2 + w)  # hook beyond the bar's right face
+            hook = (x + w / 2, s.y)
+            self.extend(s2.body, rect(x + w / 2, s.y - w, x + w / 2 + w, s.y + w))
+            self.contact(bar, s2.body, hook, hook, driven=bar)
+        y_top = max(ys) + w / 2
+        self.stop_above(bar, (x, y_top), S / 2)  # on position
+        self.stop_below(bar, (x, y_top), S / 2 + c.overtravel * S)  # over-travel
+        self.bars[bar] = ("and", len(sigs), (x + w / 2, y_spring))
+        return Sig(bar, x + w / 2, y_top), self.size(bar, demand)
+
+    def spring_row(self, ys: list[float]) -> float:
+        """A row above the inputs for the next bar's spring: springs lie on the base plate,
+        each on its own row, so they never cross one another."""
+        self.spring_rows = getattr(self, "spring_rows", 0) + 1
+        return max(ys) + self.ctx.bar * (0.5 + 1.2 * self.spring_rows)
+
+    def size(self, bar: str, demand: Demand) -> list[Demand]:
+        """(Re)size a bar's spring for the force its output must deliver; returns what each of
+        its inputs must then deliver. OR springs pull towards off, AND springs towards on."""
+        c = self.ctx
+        kind, n, at = self.bars[bar]
+        self.part.springs[:] = [s for s in self.part.springs if s.b != bar]
+        need = self.part.data.setdefault("spring_required_N", {})
+        if kind == "or":
+            preload = max(c.min_preload, c.margin * (demand.left + c.friction))
+            self.spring(bar, at, -1, preload, self.moving_mass([bar]))
+            need[self.part.springs[-1].id] = round(demand.left + c.friction, 6)
+            peak = preload * (1 + c.spring_range)
+            return [Demand(peak + demand.right + c.friction, 0.0) for _ in range(n)]
+        preload = max(c.min_preload, c.margin * (demand.right + c.friction))
+        self.spring(bar, at, +1, preload, self.moving_mass([bar]))
+        need[self.part.springs[-1].id] = round(demand.right + c.friction, 6)
+        peak = preload * (1 + c.spring_range)
+        return [Demand(0.0, peak + demand.left + c.friction) for _ in range(n)]
+
+    def rod(self, a: str, b: str, pa: Point, pb: Point) -> None:
+        length = math.hypot(pb[0] - pa[0], pb[1] - pa[1])
+        self.part.joints.append(Joint(self._id("rod"), "rod", a, b, pa=pa, pb=pb,
+                                      length=length))
+
+    def not_lever(self, local: str, sig: Sig, x: float, y_top: float, demand: Demand,
+                  out_length: float, layer: int = 2) -> tuple[Sig, Demand]:
+        """NOT: a lever pivoted at its centre, linked by a short rod at its top to ``sig``
+        (at row ``y_top``) and by another at its bottom to a new slider two arms lower, which
+        therefore moves opposite (Fig. 16c: a ternary link with binary links to the sliders)."""
+        c, S, w, r = self.ctx, self.ctx.stroke, self.ctx.bar, self.ctx.arm
+        link = 0.8 * S
+        pivot = (x, y_top - r)
+        y_out = y_top - 2 * r
+        pin_in = (x - link, y_top)
+        sig2 = self.reach(sig, pin_in[0] + w / 2)
+        lever_poly = rect(x - w / 2, y_top + w / 2, x + w / 2, y_out - w / 2)
+        lever = self.name(local)
+        self.part.bodies.append(Body(lever, "lever", [lever_poly], c.mass([lever_poly]),
+                                     pivot=pivot, layer=layer, role="NOT lever"))
+        self.rod(sig2.body, lever, pin_in, (x, y_top))
+        x_out = x + link
+        out = self.slider(f"{local}_out", x_out - w / 2, x_out - w / 2 + out_length, y_out,
+                          "NOT output")
+        self.rod(lever, out.body, (x, y_out), (x_out, y_out))
+        return out, Demand(demand.left + c.friction, demand.right + c.friction)
+
+    def output(self, sig: Sig, pin: str = "Z", reach: float | None = None) -> Sig:
+        """Put the output terminal at the right end of ``sig`` (lengthened to ``reach``)."""
+        if reach is not None:
+            sig = self.reach(sig, reach)
+        self.terminal(pin, sig.body, (sig.x, sig.y))
+        return sig
+
+    def finish(self, demands: dict[str, Demand]) -> Part:
+        self.part.data["input_loads"] = {k: v.to_json() for k, v in demands.items()}
+        return self.part

@@ -1,0 +1,1 @@
+"""The geometry kernel: circle meetings (the dyad), transforms and bounds, in mm."""

@@ -1,0 +1,145 @@
+"""The parsed specification: what every front end produces and every proof checks against."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mechc.ir import expr as ex
+from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, cube_table, input_matrix
+
+
+@dataclass
+class OutputSpec:
+    """One output: an expression or on-set cubes, don't-care and off-set cubes.
+
+    A minterm in none of the lists takes the value ``rest``: 0 for ``.bool`` and PLA types
+    f/fd, DC for fr/fdr (explicit off-set), 1 for r/dr. Precedence: dc over on over off.
+    """
+
+    name: str
+    expr: ex.Expr | None = None
+    on: list[Cube] = field(default_factory=list)
+    dc: list[Cube] = field(default_factory=list)
+    off: list[Cube] = field(default_factory=list)
+    rest: int = 0
+    line: int = 0
+
+
+@dataclass
+class Spec:
+    path: str
+    kind: str  # "bool" | "pla" | "fsm"
+    inputs: list[str]
+    outputs: list[str]
+    functions: dict[str, OutputSpec]
+    _tables: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def n(self) -> int:
+        return len(self.inputs)
+
+    def has_table(self) -> bool:
+        return self.n <= MAX_TABLE_INPUTS
+
+    def table(self, name: str) -> np.ndarray:
+        """Truth table (0/1/DC per minterm) of one output; needs n <= MAX_TABLE_INPUTS."""
+        if name not in self._tables:
+            self._tables[name] = self._build_table(self.functions[name])
+        return self._tables[name]
+
+    def _build_table(self, f: OutputSpec) -> np.ndarray:
+        n = self.n
+        if n > MAX_TABLE_INPUTS:
+            raise ValueError(f"{n} inputs is too many for a truth table")
+        if f.expr is not None:
+            m = input_matrix(n)
+            env = {name: m[k] for k, name in enumerate(self.inputs)}
+            on = ex.evaluate(f.expr, env, 1 << n)
+        else:
+            on = cube_table(f.on, n)
+        table = np.full(1 << n, f.rest, dtype=np.int8)
+        if f.off:
+            table[cube_table(f.off, n)] = 0
+        table[on] = 1
+        if f.dc:
+            table[cube_table(f.dc, n)] = DC
+        return table
+
+    def values_at(self, bits: np.ndarray) -> dict[str, np.ndarray]:
+        """Spec value (0, 1 or DC) of every output at input vectors given as a boolean
+        (n, N) matrix (row k = input k). Uses the truth table up to MAX_TABLE_INPUTS inputs and
+        the cubes beyond (any number of inputs)."""
+        n = self.n
+        if n <= MAX_TABLE_INPUTS:
+            w = (1 << np.arange(n - 1, -1, -1, dtype=np.int64))
+            rows = (bits.astype(np.int64) * w[:, None]).sum(axis=0)
+            return {o: self.table(o)[rows] for o in self.outputs}
+        out = {}
+        for o in self.outputs:
+            f = self.functions[o]
+            if f.expr is not None:
+                env = {name: bits[k] for k, name in enumerate(self.inputs)}
+                on = ex.evaluate(f.expr, env, bits.shape[1])
+            else:
+                on = _in_cubes(f.on, bits, n)
+            v = np.full(bits.shape[1], f.rest, dtype=np.int8)
+            if f.off:
+                v[_in_cubes(f.off, bits, n)] = 0
+            v[on] = 1
+            if f.dc:
+                v[_in_cubes(f.dc, bits, n)] = DC
+            out[o] = v
+        return out
+
+    # ---- JSON echo: enough to re-prove a compiled design against -------------------------
+    def to_json(self) -> dict:
+        funcs = {}
+        for name in self.outputs:
+            f = self.functions[name]
+            d: dict = {}
+            if f.expr is not None:
+                d["expr"] = ex.to_text(f.expr)
+            else:
+                d["on"] = [c.to_string(self.n) for c in f.on]
+            d["dc"] = [c.to_string(self.n) for c in f.dc]
+            if f.off:
+                d["off"] = [c.to_string(self.n) for c in f.off]
+            if f.rest:
+                d["rest"] = "dc" if f.rest == DC else 1
+            funcs[name] = d
+        return {"source": self.path, "kind": self.kind, "inputs": list(self.inputs),
+                "outputs": list(self.outputs), "functions": funcs}
+
+    @staticmethod
+    def from_json(d: dict, where: str = "<json>") -> Spec:
+        from mechc.frontends.boolfile import parse_expression_text
+
+        inputs = list(d["inputs"])
+        funcs = {}
+        for name in d["outputs"]:
+            fd = d["functions"][name]
+            f = OutputSpec(name)
+            if "expr" in fd:
+                f.expr = parse_expression_text(fd["expr"], inputs, f"{where}: spec.{name}")
+            else:
+                f.on = [Cube.from_string(s) for s in fd.get("on", [])]
+            f.off = [Cube.from_string(s) for s in fd.get("off", [])]
+            f.dc = [Cube.from_string(s) for s in fd.get("dc", [])]
+            rest = fd.get("rest", 0)
+            f.rest = DC if rest == "dc" else int(rest)
+            funcs[name] = f
+        return Spec(d.get("source", where), d.get("kind", "bool"), inputs, list(d["outputs"]),
+                    funcs)
+
+
+def _in_cubes(cubes: list[Cube], bits: np.ndarray, n: int) -> np.ndarray:
+    """Which columns of ``bits`` lie in the union of ``cubes`` (works for any n)."""
+    hit = np.zeros(bits.shape[1], dtype=bool)
+    for c in cubes:
+        m = np.ones(bits.shape[1], dtype=bool)
+        for k, positive in c.literal_list(n):
+            m &= bits[k] if positive else ~bits[k]
+        hit |= m
+    return hit

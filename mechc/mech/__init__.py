@@ -1,1 +1,0 @@
-"""Mechanisms: geometry of cells and connectors, their kinematic and dynamic models, checks."""

@@ -1,1 +1,0 @@
-"""The netlist IR (cells joined by nets, held in a networkx graph) and the mapper onto it."""

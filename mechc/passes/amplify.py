@@ -1,0 +1,155 @@
+"""Netlist pass: put AMPLIFIER cells where the circuit needs power or a snap.
+
+Two reasons, both from ``001_…`` §2.6 and Appendix B:
+
+- **force** — a net whose driver cannot move its loads (an input actuator that is asked for more
+  than its rating, a MEMORY loop whose force demand grows every time round) gets its loads
+  split into groups of at most ``Amplifier.fanout_max`` loads, each group behind its own
+  AMPLIFIER; the amplifier's input costs only its slider's friction, its output comes from the
+  motor. Every load of the net moves behind an amplifier, so all its paths keep the same delay
+  (a delay on one path only is the SET/RESET overlap of Appendix B.2).
+- **snap** — an output that must hold while an input travels but whose generator moves partway
+  because a MEMORY switches before that input has finished its stroke (the output is X in the
+  ternary analysis with the memories free to switch). The AMPLIFIER's bistable toggle switches
+  only when its input passes its switching point (half stroke in the closed form, the wedge in
+  the dynamics), so the partial motion never reaches the output.
+
+Both are plain functions ``Netlist -> Netlist``; the pipeline decides where.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from mechc.cells.library import Library
+from mechc.errors import DesignError
+from mechc.ir.netlist import CellInst, Netlist
+
+#: Used when the library's AMPLIFIER does not state how many loads it may drive.
+DEFAULT_FANOUT = 2
+
+
+def amplifier_cell(lib: Library):
+    cls = lib.for_type("AMPLIFIER", 1)
+    if cls is None:
+        raise DesignError("the cell library has no AMPLIFIER cell: the design needs one")
+    return cls
+
+
+def fanout_limit(lib: Library) -> int:
+    """How many loads the mapper puts on one AMPLIFIER (a cell class attribute)."""
+    cls = amplifier_cell(lib)
+    return int(getattr(cls, "fanout_max", DEFAULT_FANOUT))
+
+
+def _rebuild(nl: Netlist, lib: Library, cells: list[CellInst], outputs: dict[str, str]) -> Netlist:
+    out = Netlist(nl.inputs)
+    for c in cells:
+        cls = lib[c.cell]
+        out.add_cell(c, pin_names=cls.input_names(len(c.inputs)), out_pins=list(cls.outputs))
+    for name, net in outputs.items():
+        out.set_output(name, net)
+    out.check()
+    return out
+
+
+def _fresh(stem: str, taken: set[str]) -> str:
+    k = 1
+    while f"{stem}{k}" in taken:
+        k += 1
+    name = f"{stem}{k}"
+    taken.add(name)
+    return name
+
+
+def snap_outputs(nl: Netlist, lib: Library, outputs: Iterable[str]) -> Netlist:
+    """Each named primary output is driven through its own AMPLIFIER (other loads of the net
+    stay where they are)."""
+    amp = amplifier_cell(lib)
+    names = _names(nl)
+    cells = list(nl.cells.values())
+    outs = dict(nl.outputs)
+    for o in outputs:
+        net = outs[o]
+        new = _fresh(f"{o}_amp", names)
+        cells.append(CellInst(_fresh("a", names), amp.name, "AMPLIFIER", (net,), (new,),
+                              {"reason": "snap"}))
+        outs[o] = new
+    return _rebuild(nl, lib, cells, outs)
+
+
+def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str]) -> Netlist:
+    """Every load of each named net moves behind AMPLIFIERs, at most the measured fan-out per
+    amplifier; primary outputs on the net stay on it (their load is small)."""
+    amp = amplifier_cell(lib)
+    limit = fanout_limit(lib)
+    names = _names(nl)
+    cells = {c.id: c for c in nl.cells.values()}
+    loads: dict[str, list[tuple[str, int]]] = {}
+    for c in nl.cells.values():
+        if c.type == "AMPLIFIER":  # an amplifier's input costs little: it stays on the net
+            continue
+        for k, net in enumerate(c.inputs):
+            loads.setdefault(net, []).append((c.id, k))
+    reach = _memories_reached(nl)
+    extra: list[CellInst] = []
+    for net in nets:
+        # loads that feed the same MEMORY share an amplifier where they can: two amplifiers
+        # never switch at quite the same moment, and a skew between a memory's SET and RESET
+        # paths is the overlap of Appendix B.2
+        ls = sorted(loads.get(net, []), key=lambda load: (reach.get(load[0], ()), load))
+        for g in range(0, len(ls), limit):
+            new = _fresh(f"{net}_amp", names)
+            extra.append(CellInst(_fresh("a", names), amp.name, "AMPLIFIER", (net,), (new,),
+                                  {"reason": "force"}))
+            for cid, k in ls[g:g + limit]:
+                c = cells[cid]
+                ins = list(c.inputs)
+                ins[k] = new
+                cells[cid] = CellInst(c.id, c.cell, c.type, tuple(ins), c.outputs, c.params)
+    return _rebuild(nl, lib, list(cells.values()) + extra, dict(nl.outputs))
+
+
+def nets_short_of_force(nl: Netlist, mech, lib: Library) -> dict[str, str]:
+    """Nets to amplify, from the force checks of a synthesised mechanism: every input whose
+    actuator is asked for more than its rating, and, when a MEMORY loop's demand did not
+    converge, every MEMORY output (the amplifier cuts the loop and delays the feedback, which
+    is the ordering fundamental mode wants). Nets whose loads are all amplifiers already are
+    left out (amplifying again cannot help)."""
+    direct = {net for c in nl.cells.values() if c.type != "AMPLIFIER" for net in c.inputs}
+    failed = [c for c in mech.synthesis_checks() if not c.passed]
+    out: dict[str, str] = {}
+    if any(c.name == "force budget converged" for c in failed):
+        # the loops first: until they converge every demand is inflated, the actuators' too
+        for cell in nl.cells.values():
+            q = cell.outputs[0]
+            if cell.type == "MEMORY" and q in direct:
+                out[q] = "force: a MEMORY loop asks more force every time round"
+        return out
+    for c in failed:
+        if c.name == "actuator force" and c.where.startswith("input "):
+            net = c.where[len("input "):]
+            if net in direct:
+                out[net] = f"force: the actuator of {net} would need {1 / c.value:.3g}x its rating"
+    return out
+
+
+def _memories_reached(nl: Netlist) -> dict[str, tuple[str, ...]]:
+    """Cell -> the MEMORY cells its output reaches through combinational logic (sorted)."""
+    import networkx as nx
+
+    g = nl.combinational_graph()
+    out = {}
+    for cid in nl.cells:
+        down = nx.descendants(g, cid)
+        out[cid] = tuple(sorted(d for d in down if d in nl.cells
+                                and nl.cells[d].type == "MEMORY"))
+    return out
+
+
+def _names(nl: Netlist) -> set[str]:
+    taken = set(nl.inputs) | set(nl.cells) | set(nl.outputs) | set(nl.driver)
+    for c in nl.cells.values():
+        taken.update(c.inputs)
+        taken.update(c.outputs)
+    return taken

@@ -1,0 +1,230 @@
+"""Synthesis stage: netlist + layout -> a mechanism with every part dimensioned and placed.
+
+``Netlist, Layout -> Mechanism``. Steps: a force budget from the outputs back to the inputs
+(each cell's springs are sized for what its output must move, and it reports what it asks of
+its inputs); every cell synthesised at a local origin and placed by column (logic depth) and
+row (the layout's order), columns spaced by their real widths plus a channel for the nets;
+primary inputs become sliders driven by bounded-force actuators; every net becomes a fan-out
+bar on its driver's output slider with one horizontal rod to each load (the rods then work at a
+90° transmission angle in every state).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from mechc.cells.builder import Builder, Demand, SynthContext, rect
+from mechc.cells.library import Library
+from mechc.errors import DesignError
+from mechc.geometry.transform import bounds, translate
+from mechc.ir.mechanism import Check, Joint, Part, Point, Terminal
+from mechc.ir.netlist import Netlist
+from mechc.passes.place import Layout
+
+
+@dataclass
+class MechOptions:
+    stroke: float = 20.0
+    actuator_force: float = 100.0  # N, rated force of each input actuator
+    output_load: float = 0.5  # N, what each circuit output must move, either way
+
+
+@dataclass
+class Mechanism:
+    ctx: SynthContext
+    cells: dict[str, Part]  # placed cell mechanisms
+    inputs: dict[str, Part]  # input sliders (terminal pin = the input's name)
+    nets: dict[str, Part]  # rods of each net (joints between bodies of different parts)
+    outputs: dict[str, tuple[str, str]]  # output -> (owner: cell id or "in:NAME", pin)
+    actuators: dict[str, dict]  # input -> rating and requirement
+    order: list[str]  # cells in topological order
+    checks: list[Check] = field(default_factory=list)
+
+    def synthesis_checks(self) -> list[Check]:
+        """The checks decided when the mechanism was sized (forces), not by a kinematic sweep."""
+        return [c for c in self.checks if c.name in SYNTHESIS_CHECKS]
+
+    def owner_part(self, owner: str) -> Part:
+        return self.inputs[owner[3:]] if owner.startswith("in:") else self.cells[owner]
+
+    def all_parts(self):
+        yield from self.inputs.values()
+        yield from (self.cells[c] for c in self.order)
+        yield from self.nets.values()
+
+    def body_index(self) -> dict:
+        return {b.id: b for p in self.all_parts() for b in p.bodies}
+
+
+SYNTHESIS_CHECKS = ("actuator force", "force budget converged")
+
+
+def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,
+                         opts: MechOptions | None = None) -> Mechanism:
+    opts = opts or MechOptions()
+    ctx = SynthContext(stroke=opts.stroke)
+    S, w = ctx.stroke, ctx.bar
+    order = [c.id for c in nl.topo_cells()]
+    cells = {c.id: c for c in nl.cells.values()}
+    loads: dict[str, list[tuple[str, str]]] = {}  # net -> [(cell id, pin)]
+    for cid in order:
+        c = cells[cid]
+        pins = lib[c.cell].input_names(len(c.inputs))
+        for net, pin in zip(c.inputs, pins):
+            loads.setdefault(net, []).append((cid, pin))
+    out_nets = set(nl.outputs.values())
+
+    # ---- force budget and cell synthesis, outputs first -------------------------------------
+    # a feedback net (a MEMORY's state) is loaded by cells synthesised after its driver: size
+    # again with the loads found in the pass before until the demands stop growing
+    feedback = any(getattr(lib[c.cell], "stateful", False) for c in cells.values())
+    before: dict[str, Demand] = {}
+    for _ in range(4 if feedback else 1):
+        demand, local = _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before)
+        grown = any(demand[n].right > before.get(n, Demand()).right + 1e-9
+                    or demand[n].left > before.get(n, Demand()).left + 1e-9 for n in demand)
+        before = demand
+        if not grown:
+            break
+    converged = not feedback or not grown
+
+    # ---- placement: columns by depth, real sizes -------------------------------------------
+    depth = nl.depth()
+    ncol = max(depth.values(), default=0) + 1
+    cols: list[list[str]] = [[] for _ in range(ncol)]
+    for cid in sorted(order, key=lambda c: (depth[c], layout.cells[c].row if c in layout.cells
+                                             else 0)):
+        cols[depth[cid]].append(cid)
+    sizes = {cid: bounds(p) for cid, p in local.items()}
+    # nets whose fan-out bar sits in the gap after column k
+    driver_col: dict[str, int] = {name: 0 for name in nl.inputs}
+    for cid in order:
+        for net in cells[cid].outputs:
+            driver_col[net] = depth[cid]
+    gap_nets: dict[int, list[str]] = {}
+    for net in sorted(driver_col, key=lambda n: (driver_col[n], n)):
+        if net in loads:
+            gap_nets.setdefault(driver_col[net], []).append(net)
+    channel = S + 2 * w  # neighbouring fan-out bars may move a full stroke apart
+    col_x = [0.0] * ncol
+    col_w = [0.0] * ncol
+    in_len = 1.5 * S
+    col_w[0] = in_len + S / 2
+    for k in range(1, ncol):
+        col_w[k] = max(sizes[c][2] - sizes[c][0] for c in cols[k])
+    for k in range(1, ncol):
+        nets_here = len(gap_nets.get(k - 1, []))
+        col_x[k] = col_x[k - 1] + col_w[k - 1] + (nets_here + 1) * channel + S
+    row_gap = 1.5 * w
+    placed: dict[str, Part] = {}
+    for k in range(1, ncol):
+        y = 0.0
+        for cid in cols[k]:
+            x0, y0, x1, y1 = sizes[cid]
+            placed[cid] = translate(local[cid], col_x[k] - x0, y - y1)
+            y -= (y1 - y0) + row_gap
+
+    # ---- primary inputs: sliders in column 0, rows in the layout's order --------------------
+    inputs: dict[str, Part] = {}
+    in_order = sorted(nl.inputs, key=lambda n: layout.inputs[n].row if n in layout.inputs else 0)
+    pitch_in = max(ctx.pitch, 2 * w)
+    for i, name in enumerate(in_order):
+        b = Builder(f"in:{name}", ctx)
+        y = -i * pitch_in * 2
+        sig = b.slider("slider", 0.0, in_len, y, f"input {name}")
+        b.terminal(name, sig.body, (in_len, y))
+        inputs[name] = b.part
+
+    # ---- nets: fan-out bar on the driver, horizontal rods to the loads ----------------------
+    def driver_of(net: str) -> tuple[str, Terminal]:
+        if net in nl.inputs:
+            return f"in:{net}", inputs[net].terminals[net]
+        node, pin = nl.driver[net]
+        return node, placed[node].terminals[pin]
+
+    nets: dict[str, Part] = {}
+    for k, names in gap_nets.items():
+        x_gap = col_x[k] + col_w[k] + channel
+        for i, net in enumerate(names):
+            owner, term = driver_of(net)
+            dpart = inputs[owner[3:]] if owner.startswith("in:") else placed[owner]
+            tx, ty = _mid(term)
+            x_bar = x_gap + i * channel
+            ys = [ty]
+            rods = Part()
+            for j, (cid, pin) in enumerate(loads[net]):
+                lt = placed[cid].terminals[pin]
+                lx, ly = _mid(lt)
+                # a load left of its driver is a feedback path (a MEMORY's state): the rod runs
+                # back over the cells between, on the net's own plane
+                if abs(lx - x_bar) < 0.5 * S:
+                    raise DesignError(f"net {net}: load {cid}.{pin} too close to its fan-out bar")
+                rods.joints.append(Joint(f"net.{net}.rod{j + 1}", "rod", term.body, lt.body,
+                                         pa=(x_bar, ly), pb=(lx, ly), length=abs(lx - x_bar)))
+                ys.append(ly)
+            body = dpart.body(term.body)
+            layers = body.poly_layers or [body.layer] * len(body.outline)
+            net_layer = 10 + i  # each fan-out of a channel on its own plane: arms may cross
+            body.outline.append(rect(tx, ty - w / 2, x_bar + w / 2, ty + w / 2))
+            body.outline.append(rect(x_bar - w / 2, min(ys) - w / 2, x_bar + w / 2,
+                                     max(ys) + w / 2))
+            body.poly_layers = layers + [net_layer, net_layer]
+            body.mass = ctx.mass(body.outline)
+            d = demand.get(net, Demand())
+            rods.data = {"driver": owner, "fanout_bar_x": round(x_bar, 3),
+                         "demand": d.to_json(), "loads": [f"{c}.{p}" for c, p in loads[net]]}
+            nets[net] = rods
+
+    # ---- outputs and actuators --------------------------------------------------------------
+    outputs: dict[str, tuple[str, str]] = {}
+    for name, net in nl.outputs.items():
+        if net in nl.inputs:
+            outputs[name] = (f"in:{net}", net)
+        else:
+            node, pin = nl.driver[net]
+            outputs[name] = (node, pin)
+    actuators = {}
+    checks: list[Check] = []
+    if not converged:  # each pass around a MEMORY loop asks more force: it needs amplifiers
+        checks.append(Check("force budget converged", "feedback loops", 0.0, 1.0, ">="))
+    for name in nl.inputs:
+        d = demand.get(name, Demand())
+        need = max(d.right, d.left) + ctx.friction
+        actuators[name] = {"rated_force_N": opts.actuator_force,
+                           "required_right_N": round(d.right + ctx.friction, 4),
+                           "required_left_N": round(d.left + ctx.friction, 4)}
+        checks.append(Check("actuator force", f"input {name}", opts.actuator_force / need,
+                            1.0, ">=", "x"))
+    return Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
+
+
+def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):
+    """One pass of the force budget: cells from the outputs back, each sized for what its
+    output must deliver (``before``: a previous pass's demands, a floor for feedback nets)."""
+    demand: dict[str, Demand] = {}
+    for net in out_nets:
+        demand[net] = Demand(opts.output_load, opts.output_load)
+    local: dict[str, Part] = {}
+    for cid in reversed(order):
+        c = cells[cid]
+        cls = lib[c.cell]
+        d = demand.get(c.outputs[0], Demand())
+        prev = before.get(c.outputs[0])
+        if prev is not None:
+            d = Demand(max(d.right, prev.right), max(d.left, prev.left))
+        try:
+            part = cls.synthesise(cid, ctx, len(c.inputs), c.params, d)
+        except NotImplementedError:
+            raise DesignError(f"cell '{c.cell}' ({cls.source}) has no mechanism: implement "
+                              "synthesise() (see docs/write-a-cell.md)") from None
+        part.data["output_demand"] = d.to_json()
+        local[cid] = part
+        for net, pin in zip(c.inputs, cls.input_names(len(c.inputs))):
+            ld = part.data["input_loads"][pin]
+            add = Demand(ld["right_N"] + ctx.friction, ld["left_N"] + ctx.friction)
+            demand[net] = demand.get(net, Demand()) + add
+    return demand, local
+
+
+def _mid(t: Terminal) -> Point:
+    return t.design_point

@@ -1,0 +1,375 @@
+"""Two-level minimisation of every output of a spec: the ``Spec -> Equations`` stage.
+
+Default engine (exact): all prime implicants of on ∪ dc, then a minimum cover by integer
+programming. When the primes are too many for that (wide, dense functions) the engine falls back
+to expanding each uncovered on-minterm to a prime and covering with those; such results are marked
+``proven: false``. Every result is checked against the spec on every care row before it is used.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mechc.errors import MechcError, UsageError
+from mechc.ir import expr as ex
+from mechc.ir.spec import Spec
+from mechc.logic.cover import min_cover, share_covers
+from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
+from mechc.logic.espresso import check_cover, espresso
+from mechc.logic.primes import TooManyPrimes, prime_implicants
+
+
+@dataclass
+class MinimiseOptions:
+    time_limit: float = 20.0  # seconds per integer program; then the best cover found is used
+    prime_limit: int = 20_000  # more primes than this: use the expansion heuristic
+    share: bool = True  # share product terms between outputs where that saves cells
+    complements: bool = True  # also minimise each output's complement (for the mapper)
+    alt_time_limit: float = 3.0  # seconds per program for those alternatives (never reported)
+    hazard_free: bool = True  # also derive covers with consensus terms (see logic/hazards.py)
+
+
+@dataclass
+class Cover:
+    """A sum of products over the spec's inputs, with how it was obtained."""
+
+    cubes: list[Cube]
+    proven: bool  # proven minimum (terms, then literals)
+    method: str  # "exact" | "greedy" | "expand"
+    seconds: float = 0.0
+
+    @property
+    def terms(self) -> int:
+        return len(self.cubes)
+
+    @property
+    def literals(self) -> int:
+        return sum(c.literals() for c in self.cubes)
+
+
+@dataclass
+class XorForm:
+    """f = x_a ⊕ x_b ⊕ ... ⊕ g: the peeled inputs and the residual g (a cover or a constant)."""
+
+    vars: list[str]
+    residual: Cover | None
+    residual_complement: Cover | None
+    constant: int | None = None  # residual is this constant
+
+    def residual_keys(self, planner, inputs):
+        """Candidate structures for g as (key, invert-result) pairs for the mapper."""
+        if self.constant is not None:
+            return [(None, self.constant == 1)]
+        out = [(planner.sop(self.residual, inputs), False)]
+        if self.residual_complement is not None:
+            out.append((planner.sop(self.residual_complement, inputs, invert=True), False))
+        return out
+
+
+@dataclass
+class Equations:
+    inputs: list[str]
+    outputs: list[str]
+    covers: dict[str, Cover]
+    complements: dict[str, Cover] = field(default_factory=dict)  # covers of the complements
+    xor_forms: dict[str, XorForm] = field(default_factory=dict)
+    # the covers with consensus terms added (no static-1 hazard under single-input changes);
+    # the mapper builds these; ``covers`` stay the minimum the equations report
+    hazard_free: dict[str, Cover] = field(default_factory=dict)
+    hazard_free_complements: dict[str, Cover] = field(default_factory=dict)
+    shared_terms: int = 0  # product terms used by more than one output
+
+    def expr(self, name: str, complement: bool = False) -> ex.Expr:
+        cover = (self.complements if complement else self.covers)[name]
+        n = len(self.inputs)
+        return ex.sop([[(self.inputs[k], pos) for k, pos in c.literal_list(n)]
+                       for c in sort_cubes(cover.cubes, n)])
+
+    def text(self, name: str) -> str:
+        return ex.to_text(self.expr(name))
+
+    @property
+    def literals(self) -> int:
+        return sum(c.literals for c in self.covers.values())
+
+    @property
+    def terms(self) -> int:
+        return sum(c.terms for c in self.covers.values())
+
+    @property
+    def proven(self) -> bool:
+        return all(c.proven for c in self.covers.values())
+
+
+def sort_cubes(cubes: list[Cube], n: int) -> list[Cube]:
+    """Print order: fewer literals first, then by literal pattern (deterministic)."""
+    return sorted(cubes, key=lambda c: (c.literals(), c.to_string(n).replace("-", "2")))
+
+
+def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
+    opts = opts or MinimiseOptions()
+    if not spec.has_table():
+        return _minimise_wide(spec, opts)
+    n = spec.n
+    covers: dict[str, Cover] = {}
+    comps: dict[str, Cover] = {}
+    prime_sets = {}
+    comp_sets = {}
+    for name in spec.outputs:
+        table = spec.table(name)
+        covers[name], prime_sets[name] = _minimise_table(table, n, opts)
+        if opts.complements:
+            comps[name], comp_sets[name] = _minimise_alt(_complement(table), n, opts)
+    eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
+    if opts.complements:
+        for name in spec.outputs:
+            xf = _xor_form(spec.table(name), spec.inputs, opts)
+            if xf is not None:
+                eq.xor_forms[name] = xf
+    if opts.share and len(spec.outputs) > 1:
+        _share(spec, eq, prime_sets, opts)
+    eq.shared_terms = count_shared(eq)
+    if opts.hazard_free:
+        for name in spec.outputs:
+            table = spec.table(name)
+            eq.hazard_free[name] = _with_consensus(eq.covers[name], table, n, prime_sets[name],
+                                                   opts)
+            if name in comps:
+                eq.hazard_free_complements[name] = _with_consensus(
+                    comps[name], _complement(table), n, comp_sets[name], _alt(opts))
+    verify(spec, eq)
+    return eq
+
+
+def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
+    t0 = time.perf_counter()
+    on = np.flatnonzero(table == 1).astype(np.int64)
+    dc = np.flatnonzero(table == DC).astype(np.int64)
+    if len(on) == 0:
+        return Cover([], True, "exact", time.perf_counter() - t0), None
+    region = table != 0
+    try:
+        masks, values = prime_implicants(region, limit=opts.prime_limit)
+        method_note = None
+    except TooManyPrimes:
+        masks, values = expand_primes(region, on, n)
+        method_note = "expand"
+    # candidates that cover at least one on-minterm
+    useful = np.array([bool(((on & m) == v).any()) for m, v in zip(masks, values)], dtype=bool)
+    masks, values = masks[useful], values[useful]
+    res = min_cover(masks, values, on, dc, n, opts.time_limit)
+    cubes = [Cube(int(masks[i]), int(values[i])) for i in res.chosen]
+    proven = res.proven and method_note is None
+    method = method_note or res.method
+    return Cover(cubes, proven, method, time.perf_counter() - t0), (masks, values, on, dc)
+
+
+def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts) -> Cover:
+    from mechc.logic.hazards import hazard_free
+
+    if primes is None:
+        return cover
+    masks, values, _on, _dc = primes
+    cubes = hazard_free(cover.cubes, table, n, masks, values, opts.time_limit)
+    if len(cubes) == len(cover.cubes):
+        return cover
+    return Cover(cubes, False, cover.method + "+consensus", cover.seconds)
+
+
+#: Up to this many inputs the mapper's alternative forms are minimised exactly; beyond, by the
+#: espresso-style heuristic (at 10 inputs the exact complement took 1-3 s against 0.1 s).
+ALT_EXACT_MAX_INPUTS = 8
+
+
+def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
+    """A cover for one of the mapper's alternatives (complement, XOR residual): exact when
+    small, otherwise a heuristic prime cover (these are never reported as the minimum)."""
+    if n <= ALT_EXACT_MAX_INPUTS:
+        return _minimise_table(table, n, _alt(opts))
+    from mechc.logic.espresso import espresso
+
+    t0 = time.perf_counter()
+    onm = np.flatnonzero(table == 1).astype(np.int64)
+    if not len(onm):
+        return Cover([], True, "exact", 0.0), None
+    # espresso starts from cubes, not minterms: greedy primes of the on-set (inside on ∪ dc)
+    # and of the dc-set (inside dc). From 24576 minterms (the complement of a two-literal
+    # product of 15 inputs) its 3 s ran out before EXPAND had merged them, and the mapper
+    # was handed thousands of minterms.
+    on = [Cube(int(m), int(v)) for m, v in zip(*expand_primes(table != 0, onm, n))]
+    dcm = np.flatnonzero(table == DC).astype(np.int64)
+    dc = [Cube(int(m), int(v)) for m, v in zip(*expand_primes(table == DC, dcm, n))]
+    res = espresso(n, on, dc, (), 0, time_limit=min(opts.time_limit, opts.alt_time_limit))
+    masks = np.array([c.mask for c in res.cubes], dtype=np.int64)
+    values = np.array([c.value for c in res.cubes], dtype=np.int64)
+    return (Cover(list(res.cubes), False, "espresso", time.perf_counter() - t0),
+            (masks, values, onm, dcm))
+
+
+def _alt(opts: MinimiseOptions) -> MinimiseOptions:
+    """Options for the alternative forms the mapper may try (shorter time limit)."""
+    from dataclasses import replace
+
+    return replace(opts, time_limit=min(opts.time_limit, opts.alt_time_limit))
+
+
+def _complement(table: np.ndarray) -> np.ndarray:
+    return np.where(table == DC, DC, 1 - table).astype(np.int8)
+
+
+def _xor_form(table: np.ndarray, inputs: list[str], opts: MinimiseOptions) -> XorForm | None:
+    """Peel inputs x with f = x ⊕ g (g independent of x on the care set), greedily in order."""
+    n = len(inputs)
+    peeled: list[str] = []
+    t = table.copy()
+    for k in range(n):
+        shaped = t.reshape(1 << k, 2, 1 << (n - 1 - k))
+        a, b = shaped[:, 0, :], shaped[:, 1, :]
+        both = (a != DC) & (b != DC)
+        if not both.any() or (a[both] == b[both]).any():
+            continue
+        g = np.where(a != DC, a, np.where(b != DC, 1 - b, DC)).astype(np.int8)
+        shaped[:, 0, :] = g
+        shaped[:, 1, :] = g
+        t = shaped.reshape(-1)
+        peeled.append(inputs[k])
+    if not peeled:
+        return None
+    care = t != DC
+    if not care.any() or (t[care] == t[care][0]).all():
+        return XorForm(peeled, None, None, int(t[care][0]) if care.any() else 0)
+    res, rp = _minimise_alt(t, n, opts)
+    comp, cp = _minimise_alt(_complement(t), n, opts)
+    if opts.hazard_free:
+        res = _with_consensus(res, t, n, rp, opts)
+        comp = _with_consensus(comp, _complement(t), n, cp, opts)
+    return XorForm(peeled, res, comp)
+
+
+def expand_primes(region: np.ndarray, on: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Some primes: each still-uncovered on-minterm expanded greedily, literal by literal."""
+    covered = np.zeros(len(region), dtype=bool)
+    masks, values = [], []
+    full = (1 << n) - 1
+    for start in on.tolist():
+        if covered[start]:
+            continue
+        mask, value = full, start
+        for k in range(n):
+            bit = 1 << (n - 1 - k)
+            m2 = mask & ~bit
+            if _cube_inside(region, m2, value & m2, n):
+                mask, value = m2, value & m2
+        masks.append(mask)
+        values.append(value)
+        covered[_cube_points(mask, value, n)] = True
+    return np.array(masks, dtype=np.int64), np.array(values, dtype=np.int64)
+
+
+def _cube_points(mask: int, value: int, n: int) -> np.ndarray:
+    free = [1 << (n - 1 - k) for k in range(n) if not mask >> (n - 1 - k) & 1]
+    pts = np.array([value], dtype=np.int64)
+    for b in free:
+        pts = np.concatenate([pts, pts | b])
+    return pts
+
+
+def _cube_inside(region: np.ndarray, mask: int, value: int, n: int) -> bool:
+    return bool(region[_cube_points(mask, value, n)].all())
+
+
+def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None:
+    names = [nm for nm in spec.outputs if prime_sets[nm] is not None]
+    if len(names) < 2:
+        return
+    # is any prime a candidate of two outputs?
+    seen: dict[tuple[int, int], int] = {}
+    for nm in names:
+        masks, values, _on, _dc = prime_sets[nm]
+        for key in set(zip(masks.tolist(), values.tolist())):
+            seen[key] = seen.get(key, 0) + 1
+    if max(seen.values()) < 2:
+        return
+    before = {(c.mask, c.value) for nm in names for c in eq.covers[nm].cubes}
+    cands = [(prime_sets[nm][0], prime_sets[nm][1]) for nm in names]
+    chosen = share_covers(cands, [prime_sets[nm][2] for nm in names],
+                          [prime_sets[nm][3] for nm in names],
+                          [(eq.covers[nm].terms, eq.covers[nm].literals) for nm in names],
+                          spec.n, opts.time_limit)
+    if chosen is None:
+        return
+    new = {nm: [Cube(int(cands[i][0][j]), int(cands[i][1][j])) for j in chosen[i]]
+           for i, nm in enumerate(names)}
+    after = {(c.mask, c.value) for cubes in new.values() for c in cubes}
+    if len(after) >= len(before):
+        return
+    for nm in names:
+        old = eq.covers[nm]
+        eq.covers[nm] = Cover(new[nm], old.proven, old.method, old.seconds)
+
+
+def count_shared(eq: Equations) -> int:
+    """Product terms (with at least two literals) used by more than one output."""
+    counts: dict[Cube, int] = {}
+    for cover in eq.covers.values():
+        for c in set(cover.cubes):
+            if c.literals() >= 2:
+                counts[c] = counts.get(c, 0) + 1
+    return sum(1 for v in counts.values() if v > 1)
+
+
+class VerificationError(MechcError):
+    exit_code = 3
+
+
+def _minimise_wide(spec: Spec, opts: MinimiseOptions) -> Equations:
+    """Specs beyond the truth-table limit: espresso-style heuristic on cubes, per output (no
+    complement or XOR forms, no multi-output sharing beyond identical cubes), each result
+    checked exactly on cubes."""
+    covers: dict[str, Cover] = {}
+    for name in spec.outputs:
+        f = spec.functions[name]
+        if f.expr is not None:
+            raise UsageError(f"{spec.path}: output {name} is an expression over {spec.n} inputs; "
+                             f"beyond {MAX_TABLE_INPUTS} inputs only cube lists (PLA) are "
+                             "supported")
+        res = espresso(spec.n, f.on, f.dc, f.off, f.rest, time_limit=opts.time_limit)
+        covers[name] = Cover(res.cubes, False, "espresso", res.seconds)
+    eq = Equations(list(spec.inputs), list(spec.outputs), covers)
+    eq.shared_terms = count_shared(eq)
+    verify_wide(spec, eq)
+    return eq
+
+
+def verify_wide(spec: Spec, eq: Equations) -> None:
+    """Exact check of every cover against the spec's cubes (any number of inputs)."""
+    for name in spec.outputs:
+        f = spec.functions[name]
+        fault = check_cover(spec.n, eq.covers[name].cubes, f.on, f.dc, f.off, f.rest)
+        if fault is not None:
+            raise VerificationError(f"internal error: minimised {name}: {fault}")
+
+
+def verify(spec: Spec, eq: Equations) -> None:
+    """Exhaustive check of every cover against the spec on every care row."""
+    rows = np.arange(1 << spec.n, dtype=np.int64)
+    for name in spec.outputs:
+        table = spec.table(name)
+        care = table != DC
+        for label, cover, want in (
+                ("", eq.covers.get(name), table == 1),
+                ("complement of ", eq.complements.get(name), table == 0),
+                ("hazard-free ", eq.hazard_free.get(name), table == 1),
+                ("hazard-free complement of ", eq.hazard_free_complements.get(name),
+                 table == 0)):
+            if cover is None:
+                continue
+            got = eval_cover(cover.cubes, rows)
+            bad = np.flatnonzero(care & (got != want))
+            if len(bad):
+                raise VerificationError(
+                    f"internal error: minimised {label}{name} differs from the spec at input "
+                    f"{Cube.minterm(int(bad[0]), spec.n).to_string(spec.n)}")

@@ -1,0 +1,107 @@
+"""Layout v0: cells in columns by logic depth, rows ordered by barycentre sweeps to cut crossings.
+
+``Netlist -> Layout``. Coordinates are millimetres: x grows with logic depth (signals flow left to
+right, as in the dissertation's figures), y with row. Pitches are a parameter so that cell
+geometry can widen them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from mechc.ir.netlist import Netlist, in_node
+
+
+@dataclass(frozen=True)
+class Place:
+    x: float
+    y: float
+    column: int
+    row: int
+
+    def to_json(self) -> dict:
+        return {"x": round(self.x, 3), "y": round(self.y, 3), "column": self.column,
+                "row": self.row}
+
+
+@dataclass
+class Layout:
+    cells: dict[str, Place]
+    inputs: dict[str, Place]
+    pitch: tuple[float, float]
+    crossings: int
+
+    def to_json(self) -> dict:
+        return {"pitch_mm": list(self.pitch), "crossings": self.crossings,
+                "inputs": {k: v.to_json() for k, v in self.inputs.items()}}
+
+
+def place(nl: Netlist, pitch: tuple[float, float] = (140.0, 90.0), sweeps: int = 8) -> Layout:
+    depth = nl.depth()
+    ncol = max(depth.values(), default=0) + 1
+    columns: list[list[str]] = [[in_node(n) for n in nl.inputs]] + [[] for _ in range(ncol - 1)]
+    for cell in nl.topo_cells():
+        columns[depth[cell.id]].append(cell.id)
+    preds: dict[str, list[str]] = {}
+    succs: dict[str, list[str]] = {}
+    for u, v in nl.graph.edges():
+        if v.startswith("out:"):
+            continue
+        preds.setdefault(v, []).append(u)
+        succs.setdefault(u, []).append(v)
+
+    def positions(cols):
+        return {node: i for col in cols for i, node in enumerate(col)}
+
+    best = [list(c) for c in columns]
+    best_x = _crossings(best, preds)
+    cur = [list(c) for c in columns]
+    for sweep in range(sweeps):
+        rng = range(1, ncol) if sweep % 2 == 0 else range(ncol - 2, -1, -1)
+        nbrs = preds if sweep % 2 == 0 else succs
+        for ci in rng:
+            pos = positions(cur)
+            old = {node: i for i, node in enumerate(cur[ci])}
+
+            def bary(node, pos=pos, old=old, nbrs=nbrs):
+                ns = [pos[m] for m in nbrs.get(node, []) if m in pos]
+                return (sum(ns) / len(ns) if ns else old[node], old[node])
+
+            cur[ci].sort(key=bary)
+        x = _crossings(cur, preds)
+        if x < best_x:
+            best, best_x = [list(c) for c in cur], x
+    cells: dict[str, Place] = {}
+    inputs: dict[str, Place] = {}
+    for ci, col in enumerate(best):
+        offset = (max(len(c) for c in best) - len(col)) / 2.0  # centre short columns
+        for ri, node in enumerate(col):
+            p = Place(ci * pitch[0], (ri + offset) * pitch[1], ci, ri)
+            if node.startswith("in:"):
+                inputs[node[3:]] = p
+            else:
+                cells[node] = p
+    return Layout(cells, inputs, pitch, best_x)
+
+
+def _crossings(cols: list[list[str]], preds: dict[str, list[str]]) -> int:
+    """Pairs of edges between the same two columns whose straight segments cross."""
+    pos = {node: (ci, ri) for ci, col in enumerate(cols) for ri, node in enumerate(col)}
+    groups: dict[tuple[int, int], list[tuple[int, int]]] = {}
+    for v, us in preds.items():
+        if v not in pos:
+            continue
+        cv, rv = pos[v]
+        for u in us:
+            if u in pos:
+                cu, ru = pos[u]
+                groups.setdefault((cu, cv), []).append((ru, rv))
+    count = 0
+    for edges in groups.values():
+        e = np.array(edges)
+        d0 = e[:, 0][:, None] - e[:, 0][None, :]
+        d1 = e[:, 1][:, None] - e[:, 1][None, :]
+        count += int(np.triu((d0 * d1) < 0, 1).sum())
+    return count

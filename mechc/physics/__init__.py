@@ -1,0 +1,1 @@
+"""How a mechanism moves: the closed-form kinematics of its parts, and the pymunk scene."""

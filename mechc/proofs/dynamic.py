@@ -1,0 +1,216 @@
+"""Dynamic level: the pymunk scene driven through input changes, measured against the spec
+and against the closed-form (kinematic) positions.
+
+Cases: a Gray-code tour that visits every input vector (each step one input change) followed by
+``extra`` seeded random single-input changes. Per change the proof fails when: an output at
+rest is not within ``tolerance`` of the value the spec asks for; an output the change must not
+move leaves that margin on the way (a glitch); the scene does not settle in time; an input's
+actuator cannot bring its slider to the target (stall); a bilateral joint stretches beyond its
+limit or a contact is overrun beyond its limit ("solver error" — pymunk stretches joints
+silently when overdriven or stepped too coarsely, so this is never passed).
+
+With ``prune`` each change runs on a scene of only the cells that can move the outputs
+(``mechc.proofs.prune``); off by default, see docs/performance.md for why.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from mechc.cells.library import Library
+from mechc.errors import UsageError
+from mechc.ir.spec import Spec
+from mechc.logic.cubes import DC
+from mechc.passes.checks import CheckStats
+from mechc.physics.scene import DynSettings, Scene
+from mechc.pipeline import Design
+from mechc.proofs.cases import gray_tour, random_walk
+from mechc.proofs.kinematic import sweep
+from mechc.proofs.logic import check_interface
+from mechc.proofs.prune import FREEZE, blocker, run_case
+
+MAX_LISTED = 50
+PRUNE_DEFAULT = False  # per-change pruned scenes (mechc.proofs.prune); see docs/performance.md
+
+
+def plan(n: int, extra: int, seed: int) -> list[int]:
+    """Input vectors to visit in order, starting from all inputs off."""
+    tour = gray_tour(n)[1:]
+    if n > 10:  # a full tour is too long: a seeded random walk instead
+        return random_walk(n, 0, max(extra, 64), seed)
+    walk = random_walk(n, tour[-1] if tour else 0, extra, seed)
+    return tour + walk
+
+
+def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSettings | None = None,
+                  tolerance: float = 0.05, extra: int = 16, seed: int = 0,
+                  progress: Callable[[int, int], None] | None = None,
+                  cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
+                  max_cases: int | None = None, record: list | None = None,
+                  freeze: str | None = None) -> dict:
+    """``prune``: each change runs on its own scene holding only what can move the outputs
+    (``mechc.proofs.prune``; every change then starts from the closed-form rest pose); else one
+    scene of the whole mechanism (or of ``cells``) runs the whole tour. ``max_cases`` keeps
+    the first changes of the plan only; ``record`` (a list) receives each change's inputs and
+    final output positions (for step-halving checks); ``freeze``: which still bodies a pruned
+    scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``)."""
+    t0 = time.perf_counter()
+    st = settings or DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
+                                 if design.mechanism else 0.1)
+    if design.mechanism is None:
+        raise UsageError("the design has no geometry (compile it with this mechc version)")
+    check_interface(design.netlist, spec)
+    mech = design.mechanism
+    names = list(spec.inputs)
+    n = len(names)
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    why_not = None if prune and cells is None else "not requested"
+    if why_not is None:
+        why_not = blocker(design.netlist, lib)
+    prune = why_not is None
+    scene = None if prune else Scene.build(mech, lib, types, st, {k: 0.0 for k in names}, cells)
+    state = {k: 0.0 for k in names}
+    sizes: list[tuple[int, int, int]] = []  # pruned scenes: (cells, dynamic bodies, constraints)
+    escalated = 0
+    max_watch = 0.0
+    vectors = plan(n, extra, seed)
+    if max_cases is not None:
+        vectors = vectors[:max_cases]
+    cols = np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in [0, *vectors]],
+                    dtype=bool).T
+    wants = spec.values_at(cols)  # spec value before (column i) and after (i + 1) each change
+    failures: list[dict] = []
+    counts = {"rest": 0, "glitch": 0, "settle": 0, "stall": 0, "solver": 0, "contact": 0}
+    max_err = max_vio = max_pen = max_settle = 0.0
+    worst_joint = ""
+    max_dev = 0.0
+    cur = 0
+    steps = 0
+    for i, vec in enumerate(vectors):
+        diff = cur ^ vec
+        k = n - 1 - diff.bit_length() + 1
+        name = names[k]
+        target = (vec >> (n - 1 - k)) & 1
+        if prune:
+            run = run_case(design.netlist, mech, lib, types, st, state, name, float(target),
+                           freeze=freeze)
+            r = run.result
+            sizes.append((run.cells, run.bodies, run.constraints))
+            escalated += run.escalated
+            max_watch = max(max_watch, run.watch_deviation)
+        else:
+            r = scene.move(name, float(target))
+        state[name] = float(target)
+        steps += r.steps
+        case = {"inputs": _vec(vec, names), "moving": name, "to": int(target)}
+        if record is not None:
+            record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation})
+
+        def fail(kind, case=case, **info):
+            counts[kind] += 1
+            if len(failures) < MAX_LISTED:
+                failures.append({"kind": kind, **case, **info})
+
+        if r.max_violation > max_vio:
+            max_vio, worst_joint = r.max_violation, r.worst_joint
+        max_pen = max(max_pen, r.max_penetration)
+        if r.max_violation > st.violation_limit or not math.isfinite(r.max_violation):
+            fail("solver", message=f"solver error: joint {r.worst_joint} stretched "
+                 f"{r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
+        if r.max_penetration > st.penetration_limit:
+            fail("contact", message=f"solver error: a contact overrun by {r.max_penetration:.4g}"
+                 f" mm (limit {st.penetration_limit} mm)")
+        if not math.isfinite(r.settle_time):
+            fail("settle", message=f"not settled {st.settle_time} s after the move")
+        else:
+            max_settle = max(max_settle, r.settle_time)
+        lag = r.servo_lag_end if hasattr(r, "servo_lag_end") else None
+        if lag is not None and lag > tolerance * mech.ctx.stroke:
+            fail("stall", message=f"input {name} ended {lag:.3g} mm short of its target")
+        for o in spec.outputs:
+            want = int(wants[o][i + 1])
+            before = int(wants[o][i])
+            got = r.final.get(o)
+            if got is None:
+                continue
+            ref_end = float(r.reference[o][-1]) if o in r.reference else got
+            max_err = max(max_err, abs(got - ref_end))
+            if want != DC:
+                dev = abs(got - want)
+                max_dev = max(max_dev, dev)
+                if dev > tolerance or not math.isfinite(dev):
+                    fail("rest", output=o, expected=want, position=round(got, 6))
+            if want != DC and want == before and o in r.outputs:
+                glitch = float(np.max(np.abs(r.outputs[o] - want)))
+                max_dev = max(max_dev, glitch)
+                if glitch > tolerance:
+                    fail("glitch", output=o, expected=want, max_deviation=round(glitch, 6))
+        cur = vec
+        if progress:
+            progress(i + 1, len(vectors))
+    stats = CheckStats(mech)
+    sweep(design, lib, samples=5, stats=stats)
+    kin_checks = stats.checks() + mech.synthesis_checks()
+    mus = [c.value for c in kin_checks if c.name == "transmission angle"]
+    bad_checks = [c for c in kin_checks if not c.passed]
+    for c in bad_checks:
+        if len(failures) < MAX_LISTED:
+            failures.append({"kind": "design check", "check": c.name, "where": c.where,
+                             "value": round(c.value, 6), "limit": c.limit,
+                             "message": c.text()})
+    total_fail = sum(counts.values()) + len(bad_checks)
+    return {
+        "passed": total_fail == 0,
+        "level": "dynamic",
+        "cases": len(vectors),
+        "tour": min(len(vectors), (1 << n) - 1) if n <= 10 else 0,
+        "random_changes": extra,
+        "seed": seed,
+        "tolerance_fraction": tolerance,
+        "failure_count": total_fail,
+        "failure_kinds": {k: v for k, v in counts.items() if v},
+        "failures": failures,
+        "max_position_error_fraction": round(max_err, 6),
+        "max_deviation_fraction": round(max_dev, 6),
+        "min_margin_fraction": round(0.5 - max_dev, 6),
+        "max_joint_violation_mm": round(max_vio, 6),
+        "worst_joint": worst_joint,
+        "max_contact_penetration_mm": round(max_pen, 6),
+        "max_settle_time_s": round(max_settle, 5),
+        "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
+        "steps": steps,
+        "scene": _scene_json(scene, sizes),
+        "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order), freeze),
+        "settings": st.to_json(),
+        "seconds": round(time.perf_counter() - t0, 4),
+    }
+
+
+def _scene_json(scene: Scene | None, sizes: list[tuple[int, int, int]]) -> dict:
+    """The whole scene's size, or the largest pruned scene's."""
+    if scene is not None:
+        return {"bodies": len(scene.bodies), "joints": len(scene.joints),
+                "constraints": len(scene.space.constraints), "cells": len(scene.cells)}
+    big = max(sizes, key=lambda x: x[2], default=(0, 0, 0))
+    return {"bodies": big[1], "constraints": big[2], "cells": big[0], "largest_of": len(sizes)}
+
+
+def _pruning_json(why_not: str | None, sizes: list[tuple[int, int, int]], escalated: int,
+                  max_watch: float, cells: int, freeze: str | None = None) -> dict:
+    if why_not is not None:
+        return {"enabled": False, "reason": why_not}
+    a = np.array(sizes, dtype=float).reshape(-1, 3)
+    return {"enabled": True, "circuit_cells": cells, "freeze": freeze or FREEZE,
+            "mean_cells": round(float(a[:, 0].mean()), 3) if len(a) else 0.0,
+            "mean_dynamic_bodies": round(float(a[:, 1].mean()), 3) if len(a) else 0.0,
+            "mean_constraints": round(float(a[:, 2].mean()), 3) if len(a) else 0.0,
+            "escalated_cases": escalated, "max_watch_deviation_fraction": round(max_watch, 6)}
+
+
+def _vec(row: int, names: list[str]) -> dict[str, int]:
+    n = len(names)
+    return {nm: int((int(row) >> (n - 1 - k)) & 1) for k, nm in enumerate(names)}

@@ -1,0 +1,281 @@
+"""Sequential proofs of the mechanism: the closed form and the pymunk scene walked through the
+spec's input sequences in fundamental mode (one input changes, the circuit settles).
+
+The walks are the logic level's (``transition_tour``: every specified transition from every
+reachable stable state, then seeded random walks); the expected outputs at each stable state
+come from the spec's own semantics (``expected_after``), never from the netlist. Per step the
+proof fails on: a wrong output at rest, a glitch on an output the step must not change, a
+MEMORY driven by SET and RESET together (the lever binds: reported as an S·R overlap), states
+that keep changing (oscillation), and at the dynamic level the solver checks of
+``mechc.proofs.dynamic`` (joint stretch, contact overrun, settle, stall).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from mechc.cells.library import Library
+from mechc.errors import UsageError
+from mechc.passes.checks import CheckStats
+from mechc.physics.closed_form import KinematicsError
+from mechc.physics.evaluate import output_signals, settle
+from mechc.physics.scene import DynSettings, Scene
+from mechc.pipeline import Design
+from mechc.proofs.seq_logic import expected_after, transition_tour
+
+MAX_LISTED = 50
+
+
+def _types(design: Design) -> dict[str, str]:
+    return {c.id: c.cell for c in design.netlist.cells.values()}
+
+
+def stateful_cells(design: Design, lib: Library) -> list[str]:
+    return [c.id for c in design.netlist.cells.values()
+            if getattr(lib[c.cell], "stateful", False)]
+
+
+class _Failures:
+    def __init__(self):
+        self.items: list[dict] = []
+        self.counts: dict[str, int] = {}
+        self.by_cell: dict[tuple[str, str], int] = {}
+
+    def add(self, kind: str, **info) -> None:
+        self.counts[kind] = self.counts.get(kind, 0) + 1
+        if "cell" in info:  # every one counted per cell, also past the listed ones
+            key = (kind, info["cell"])
+            self.by_cell[key] = self.by_cell.get(key, 0) + 1
+        if len(self.items) < MAX_LISTED:
+            self.items.append({"kind": kind, **info})
+
+    @property
+    def total(self) -> int:
+        return sum(self.counts.values())
+
+
+def _synthesis_failures(fails: _Failures, design: Design) -> None:
+    """Force checks decided at synthesis fail the proof too (a design that needs amplifiers)."""
+    for c in design.mechanism.synthesis_checks():
+        if not c.passed:
+            fails.add("design check", check=c.name, where=c.where, value=round(c.value, 6),
+                      limit=c.limit, message=c.text())
+
+
+def _walks(spec, seed: int, random_walks: int):
+    seqs = transition_tour(spec, seed=seed, random_walks=random_walks)
+    return [(s, expected_after(spec, s)) for s in seqs]
+
+
+def _judge_outputs(fails, where, outs_end, outs_path, before, after, tolerance, dev_acc):
+    for o, want in after.items():
+        if want is None or o not in outs_end:
+            continue
+        got = float(outs_end[o])
+        dev = abs(got - want)
+        dev_acc[0] = max(dev_acc[0], dev if math.isfinite(dev) else math.inf)
+        if not dev <= tolerance:
+            fails.add("rest", **where, output=o, expected=int(want), position=round(got, 6))
+        if before.get(o) is not None and before[o] == want and o in outs_path:
+            glitch = float(np.max(np.abs(np.asarray(outs_path[o]) - want)))
+            dev_acc[0] = max(dev_acc[0], glitch)
+            if glitch > tolerance:
+                fails.add("glitch", **where, output=o, expected=int(want),
+                          max_deviation=round(glitch, 6))
+
+
+def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float = 0.05,
+                               samples: int = 21, seed: int = 0, random_walks: int = 4,
+                               stats: CheckStats | None = None) -> dict:
+    """Walk the closed form through the spec's sequences (each step sampled along the moving
+    input, the stateful cells settled at every sample)."""
+    try:
+        return _prove_sequential_kinematic(design, spec, lib, tolerance, samples, seed,
+                                           random_walks, stats)
+    except KinematicsError as e:  # as the combinational kinematic proof reports it
+        raise UsageError(f"the geometry is not a determinate mechanism: {e}") from None
+
+
+def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float,
+                                samples: int, seed: int, random_walks: int,
+                                stats: CheckStats | None) -> dict:
+    t0 = time.perf_counter()
+    mech, types = design.mechanism, _types(design)
+    mems = stateful_cells(design, lib)
+    fails = _Failures()
+    _synthesis_failures(fails, design)
+    dev = [0.0]
+    steps = 0
+    t = np.linspace(0.0, 1.0, samples)
+    for si, (seq, want) in enumerate(_walks(spec, seed, random_walks)):
+        cur = {k: float(v) for k, v in seq[0].items()}
+        vals = {k: np.array([v]) for k, v in cur.items()}
+        poses, state, osc = settle(mech, lib, types, vals)
+        if stats is not None:
+            stats.add(poses)
+        _judge_outputs(fails, {"sequence": si, "step": 0}, _last(output_signals(mech, poses)),
+                       {}, {}, want[0], tolerance, dev)
+        for k in range(1, len(seq)):
+            moved = next(n for n in seq[k] if seq[k][n] != cur[n])
+            vals = {n: np.full(samples, v) for n, v in cur.items()}
+            vals[moved] = cur[moved] + (seq[k][moved] - cur[moved]) * t
+            prior = {c: np.full(samples, v[-1]) for c, v in state.items()}
+            poses, path_state, osc = settle(mech, lib, types, vals, prior)
+            if stats is not None:
+                stats.add(poses)
+            where = {"sequence": si, "step": k, "moving": moved, "to": int(seq[k][moved]),
+                     "inputs": {n: int(v) for n, v in seq[k].items()}}
+            jam = [c for c in mems if any(poses.bad.get(b.id, np.zeros(1, bool)).any()
+                                          for b in mech.cells[c].bodies)]
+            for c in jam:
+                fails.add("S·R overlap", **where, cell=c,
+                          message=f"MEMORY {c} driven by SET and RESET at once (binds)")
+            if osc.any():
+                fails.add("oscillation", **where, message="the states keep changing")
+            outs = output_signals(mech, poses)
+            _judge_outputs(fails, where, _last(outs), outs, want[k - 1], want[k], tolerance, dev)
+            state = path_state
+            cur = {n: float(v) for n, v in seq[k].items()}
+            steps += 1
+    return {"passed": fails.total == 0, "level": "kinematic",
+            "steps": steps, "cases": steps, "memories": len(mems),
+            "tolerance_fraction": tolerance,
+            "failure_count": fails.total, "failure_kinds": fails.counts,
+            "overlaps_by_cell": {c: n for (k, c), n in fails.by_cell.items()
+                                 if k == "S·R overlap"},
+            "failures": fails.items, "max_deviation_fraction": round(dev[0], 6),
+            "min_margin_fraction": round(0.5 - dev[0], 6),
+            "seconds": round(time.perf_counter() - t0, 3)}
+
+
+#: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
+MEMORY_THROW_S = 0.03
+
+
+def settle_allowance(design: Design, lib: Library) -> float:
+    """How long after an input's move a sequential circuit may still be switching: along the
+    slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
+    transition may pass through every memory in turn. Used as the hold of each change, so a
+    circuit that is slow by design is not reported unsettled (it still must settle)."""
+    import networkx as nx
+
+    nl = design.netlist
+    g = nl.combinational_graph()
+    delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
+             for c in nl.cells.values()}
+    longest: dict[str, float] = {}
+    for node in nx.topological_sort(g):
+        here = max((longest[u] for u in g.predecessors(node)), default=0.0)
+        longest[node] = here + delay.get(node, 0.0)
+    path = max(longest.values(), default=0.0)
+    m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
+    return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
+
+
+def _memory_inputs(mech, lib, types, scene) -> dict[str, tuple[str, str]]:
+    """Stateful cell -> (S body, R body) for the cells present in the scene."""
+    out = {}
+    for cid, part in mech.cells.items():
+        if getattr(lib[types[cid]], "stateful", False) and "S" in part.terminals:
+            pair = (part.terminals["S"].body, part.terminals["R"].body)
+            if all(b in scene.bodies for b in pair):
+                out[cid] = pair
+    return out
+
+
+def _binding(mech, lib, types, watch, watched) -> list[str]:
+    """Stateful cells whose recorded S and R positions the closed form cannot accept (the
+    faces press the lever from both sides): an S·R overlap seen in the dynamics, e.g. one path
+    delayed by an AMPLIFIER (001 Appendix B.2)."""
+    bad = []
+    for cid, (s_body, r_body) in watch.items():
+        if s_body not in watched or r_body not in watched:
+            continue
+        us, ur = watched[s_body], watched[r_body]
+        part = mech.cells[cid]
+        poses = lib[types[cid]].kinematics(part, {s_body: us, r_body: ur}, len(us),
+                                           np.zeros(len(us)))
+        lever = [b.id for b in part.bodies if b.id in poses.bad]
+        if any(poses.bad[b].any() for b in lever):
+            bad.append(cid)
+    return bad
+
+
+def _last(outs: dict[str, np.ndarray]) -> dict[str, float]:
+    return {o: float(np.ravel(v)[-1]) for o, v in outs.items()}
+
+
+def prove_sequential_dynamic(design: Design, spec, lib: Library,
+                             settings: DynSettings | None = None, tolerance: float = 0.05,
+                             seed: int = 0, random_walks: int = 2,
+                             progress: Callable[[int, int], None] | None = None,
+                             sequences: list[list[dict[str, int]]] | None = None) -> dict:
+    """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
+    each from the power-up inputs); a fresh scene per sequence starts at power-up."""
+    t0 = time.perf_counter()
+    mech, types = design.mechanism, _types(design)
+    st = settings or DynSettings(violation_limit=0.005 * mech.ctx.stroke)
+    if settings is None:
+        st.settle_time = max(st.settle_time, settle_allowance(design, lib))
+    walks = (_walks(spec, seed, random_walks) if sequences is None
+             else [(s, expected_after(spec, s)) for s in sequences])
+    total = sum(len(s) - 1 for s, _ in walks)
+    fails = _Failures()
+    _synthesis_failures(fails, design)
+    dev = [0.0]
+    max_vio = max_pen = max_err = max_settle = 0.0
+    worst = ""
+    done = 0
+    for si, (seq, want) in enumerate(walks):
+        cur = {k: float(v) for k, v in seq[0].items()}
+        scene = Scene.build(mech, lib, types, st, cur)
+        watch = _memory_inputs(mech, lib, types, scene)
+        scene.watch = [b for pair in watch.values() for b in pair]
+        for k in range(1, len(seq)):
+            moved = next(n for n in seq[k] if seq[k][n] != cur[n])
+            r = scene.move(moved, float(seq[k][moved]))
+            where = {"sequence": si, "step": k, "moving": moved, "to": int(seq[k][moved]),
+                     "inputs": {n: int(v) for n, v in seq[k].items()}}
+            if r.max_violation > max_vio:
+                max_vio, worst = r.max_violation, r.worst_joint
+            max_pen = max(max_pen, r.max_penetration)
+            if not r.max_violation <= st.violation_limit:
+                fails.add("solver", **where, message=f"solver error: joint {r.worst_joint} "
+                          f"stretched {r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
+            for c in _binding(mech, lib, types, watch, r.watched):
+                fails.add("S·R overlap", **where, cell=c, message=f"MEMORY {c}: SET and RESET "
+                          "pressed the lever from both sides at once (binds)")
+            if r.max_penetration > st.penetration_limit:
+                fails.add("contact", **where, message=f"a contact overrun by "
+                          f"{r.max_penetration:.4g} mm (limit {st.penetration_limit} mm)")
+            if not math.isfinite(r.settle_time):
+                fails.add("settle", **where, message=f"not settled {st.settle_time} s after")
+            else:
+                max_settle = max(max_settle, r.settle_time)
+            if r.servo_lag_end > tolerance * mech.ctx.stroke:
+                fails.add("stall", **where, message=f"input {moved} ended "
+                          f"{r.servo_lag_end:.3g} mm short of its target")
+            for o, got in r.final.items():
+                if o in r.reference:
+                    max_err = max(max_err, abs(got - float(r.reference[o][-1])))
+            _judge_outputs(fails, where, r.final, r.outputs, want[k - 1], want[k], tolerance,
+                           dev)
+            cur[moved] = float(seq[k][moved])
+            done += 1
+            if progress:
+                progress(done, total)
+    return {"passed": fails.total == 0, "level": "dynamic",
+            "cases": done, "sequences": len(walks), "seed": seed,
+            "tolerance_fraction": tolerance, "failure_count": fails.total,
+            "failure_kinds": fails.counts, "failures": fails.items,
+            "max_position_error_fraction": round(max_err, 6),
+            "max_deviation_fraction": round(dev[0], 6),
+            "min_margin_fraction": round(0.5 - dev[0], 6),
+            "max_joint_violation_mm": round(max_vio, 6), "worst_joint": worst,
+            "max_contact_overrun_mm": round(max_pen, 6),
+            "max_settle_time_s": round(max_settle, 6), "settings": st.to_json(),
+            "seconds": round(time.perf_counter() - t0, 3)}

@@ -1,1 +1,0 @@
-"""Proofs of a design against a spec: logic, kinematic and dynamic levels."""
