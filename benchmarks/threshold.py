@@ -96,7 +96,7 @@ def cells(xc: np.ndarray, samples: int) -> None:
     the reference is the generator's own closed form on the same states, timed above."""
     from mechc.stdlib.threshold import ThresholdCell
 
-    from mechc.cells.builder import Demand, SynthContext
+    from mechc.ir.mechanism import Demand, SynthContext
     from mechc.passes.threshold_map import params_of
     from mechc.physics.evaluate import signal_of
     from mechc.threshold.weights import realise

@@ -13,12 +13,16 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from mechc.cells.library import Library, load_library
+from mechc.ir.design import Design
+from mechc.ir.equations import Equations
+from mechc.ir.layout import Layout
+from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
-from mechc.passes.assemble import Mechanism, MechOptions, synthesise_mechanism
+from mechc.passes.assemble import MechOptions, synthesise_mechanism
 from mechc.passes.map import MapOptions, map_equations
-from mechc.passes.minimise import Equations, MinimiseOptions, minimise
-from mechc.passes.place import Layout, place
+from mechc.passes.minimise import MinimiseOptions, minimise
+from mechc.passes.place import place
 
 
 @dataclass
@@ -29,22 +33,6 @@ class CompileOptions:
     cell_dirs: tuple[str, ...] = ()
     amplify: bool = True  # insert AMPLIFIERs where forces fail or an output must snap
     timings: bool = False  # record seconds per stage in the JSON (makes output non-reproducible)
-
-
-@dataclass
-class Design:
-    """Everything the compiler produced; what the JSON file holds and ``simulate`` reads."""
-
-    spec: Spec
-    equations: dict[str, str]
-    implemented: dict[str, str]
-    netlist: Netlist
-    layout: Layout | None
-    stats: dict
-    seconds: dict[str, float] = field(default_factory=dict)
-    eq: Equations | None = None  # the minimiser's full result (not kept in JSON)
-    mechanism: Mechanism | None = None
-    sequential: object | None = None  # SeqEquations of a sequential spec (mechc.passes.flowtable)
 
 
 def compile_spec(spec: Spec, opts: CompileOptions | None = None,
@@ -230,7 +218,7 @@ def run_design_checks(design: Design, lib: Library) -> None:
 def _memory_checks(design: Design, lib: Library, stats) -> list:
     """A sequential design is also walked through every specified transition (the kinematic
     sequential proof): each MEMORY's SET and RESET must never press its lever together."""
-    from mechc.ir.mechanism import Check
+    from mechc.ir.check import Check
     from mechc.proofs.seq_mechanism import prove_sequential_kinematic
 
     r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)

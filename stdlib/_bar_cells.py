@@ -5,8 +5,9 @@ An AND bar's hooks reach below its lowest input, so its output row sits half a p
 than an OR bar's, and the inverting lever under it one pitch lower.
 """
 
-from mechc.cells.builder import Builder, Demand, Sig
+from mechc.cells.builder import Builder, Sig
 from mechc.cells.cell import Cell
+from mechc.ir.mechanism import Demand
 
 
 def _bar(b: Builder, kind: str):

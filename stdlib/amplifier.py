@@ -39,10 +39,10 @@ import numpy as np
 import pymunk
 from scipy.optimize import brentq
 
-from mechc.cells.builder import Builder, Demand, SynthContext, rect
+from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.errors import DesignError
-from mechc.ir.mechanism import GROUND, Body, Joint, Part, Point, Spring
+from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Part, Point, Spring, SynthContext
 from mechc.physics.closed_form import solve
 
 #: A table computed once by ``python benchmarks/amplifier.py`` (pymunk, default SynthContext

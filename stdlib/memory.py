@@ -18,9 +18,9 @@ import math
 
 import numpy as np
 
-from mechc.cells.builder import Builder, Demand, rect
+from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
-from mechc.ir.mechanism import GROUND, Body, Joint, Spring
+from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Spring
 from mechc.physics.closed_form import KinematicsError, Poses, _slider_from_rod
 
 PUSH = 0.6  # contact travel of an input arm from upright to a stop, in strokes

@@ -1,7 +1,8 @@
 """NOT: a ternary lever pivoted at its centre; the input moves right, the output left (Fig 16c)."""
 
-from mechc.cells.builder import Builder, Demand
+from mechc.cells.builder import Builder
 from mechc.cells.cell import Cell
+from mechc.ir.mechanism import Demand
 
 
 class NotLever(Cell):

@@ -41,10 +41,10 @@ from functools import lru_cache
 
 import numpy as np
 
-from mechc.cells.builder import Builder, Demand, SynthContext, rect
+from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.errors import DesignError
-from mechc.ir.mechanism import Body, Joint, Point
+from mechc.ir.mechanism import Body, Demand, Joint, Point, SynthContext
 from mechc.linkage_synthesis import three_bar as tb
 
 # Geometry as fractions of the stroke (the gate scales exactly). Chosen from a scan of healthy

@@ -25,11 +25,11 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from mechc.cells.builder import Builder, Demand
+from mechc.cells.builder import Builder
 from mechc.cells.cell import Cell
 from mechc.errors import DesignError
 from mechc.ir.logic_types import evaluate_type
-from mechc.ir.mechanism import Body, Joint, Part
+from mechc.ir.mechanism import Body, Demand, Joint, Part
 from mechc.physics.closed_form import Poses, solve
 from mechc.threshold.cam import Follower, FollowerProgram
 from mechc.threshold.functions import input_matrix

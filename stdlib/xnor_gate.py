@@ -2,8 +2,9 @@
 
 from mechc.stdlib.xor_gate import build_xor
 
-from mechc.cells.builder import Builder, Demand, Sig
+from mechc.cells.builder import Builder, Sig
 from mechc.cells.cell import Cell
+from mechc.ir.mechanism import Demand
 
 
 class XnorGate(Cell):

@@ -5,8 +5,9 @@ function from the Chapter II blocks: each input holds back one AND bar directly 
 through its own inverting lever, and an OR bar takes either AND bar.
 """
 
-from mechc.cells.builder import Builder, Demand
+from mechc.cells.builder import Builder
 from mechc.cells.cell import Cell
+from mechc.ir.mechanism import Demand
 
 
 def build_xor(b: Builder, demand: Demand):

@@ -10,10 +10,9 @@ import pytest
 from mechc.stdlib.amplifier import MEASURED, design, toggle_torque
 from scipy.optimize import brentq
 
-from mechc.cells.builder import Demand, SynthContext
 from mechc.cells.library import load_library
 from mechc.frontends.boolfile import parse_bool
-from mechc.ir.mechanism import Part
+from mechc.ir.mechanism import Demand, Part, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.physics.closed_form import solve
 from mechc.physics.scene import DynSettings, Scene

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from mechc.cells.builder import Demand, SynthContext
 from mechc.cells.library import load_library
 from mechc.errors import DesignError
 from mechc.frontends.boolfile import parse_bool
+from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.passes.assemble import MechOptions
 from mechc.physics.scene import DynSettings, Scene

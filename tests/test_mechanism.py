@@ -12,10 +12,10 @@ import pytest
 from scipy.optimize import brentq
 
 from mechc.backends.design_json import design_from_json, design_to_json
-from mechc.cells.builder import Demand, SynthContext
 from mechc.cells.library import load_library
 from mechc.frontends import load_spec
 from mechc.frontends.boolfile import parse_bool
+from mechc.ir.mechanism import Demand, SynthContext
 from mechc.physics.closed_form import position, solve
 from mechc.pipeline import compile_spec
 from mechc.proofs.dynamic import prove_dynamic

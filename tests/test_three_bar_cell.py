@@ -20,10 +20,11 @@ from mechc.stdlib.three_bar import (
     velocity_ratios,
 )
 
-from mechc.cells.builder import Builder, Demand, SynthContext
+from mechc.cells.builder import Builder
 from mechc.cells.library import Library, load_library
 from mechc.errors import DesignError, UsageError
 from mechc.frontends.boolfile import parse_bool
+from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.linkage_synthesis import three_bar as tb
 from mechc.physics.closed_form import position, solve

@@ -12,11 +12,12 @@ from pathlib import Path
 
 from mechc import FORMAT_VERSION, __version__
 from mechc.errors import SpecError, UsageError
+from mechc.frontends.spec_json import seqspec_from_json, spec_from_json
+from mechc.ir.design import Design
+from mechc.ir.layout import Layout, Place
 from mechc.ir.mechanism import GROUND
 from mechc.ir.netlist import Netlist
-from mechc.ir.spec import Spec
-from mechc.passes.place import Layout, Place
-from mechc.pipeline import Design
+from mechc.ir.seqspec import SequentialError
 
 
 def design_to_json(d: Design, timings: bool = False) -> dict:
@@ -288,13 +289,11 @@ def design_from_json(obj: dict, where: str = "<json>") -> Design:
 
 def _spec_from_json(d: dict, where: str):
     if d.get("kind") == "fsm":
-        from mechc.ir.seqspec import SeqSpec, SequentialError
-
         try:
-            return SeqSpec.from_json(d, where)
+            return seqspec_from_json(d, where)
         except SequentialError as e:  # a DesignError (exit 1), but here the file is wrong
             raise ValueError(str(e)) from None
-    return Spec.from_json(d, where)
+    return spec_from_json(d, where)
 
 
 def _why(e: Exception) -> str:

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, fields
 
-from mechc.cells.builder import SynthContext
-from mechc.ir.mechanism import Check, Part
-from mechc.passes.assemble import Mechanism
+from mechc.ir.check import Check
+from mechc.ir.mechanism import Mechanism, Part, SynthContext
 
 
 def mechanism_json(m: Mechanism) -> dict:

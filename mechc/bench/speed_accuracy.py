@@ -23,8 +23,9 @@ import numpy as np
 
 from mechc.bench import stability
 from mechc.cells.library import Library, load_library
+from mechc.ir.design import Design
 from mechc.physics.scene import DynSettings, Scene
-from mechc.pipeline import Design, compile_spec
+from mechc.pipeline import compile_spec
 from mechc.proofs.accuracy import MODEL_PATH, ErrorModel, ModelPoint
 from mechc.proofs.dynamic import PRUNE_DEFAULT, prove_dynamic
 from mechc.proofs.kinematic import prove_kinematic

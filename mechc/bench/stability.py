@@ -22,8 +22,8 @@ from __future__ import annotations
 import copy
 import math
 
+from mechc.ir.design import Design
 from mechc.ir.mechanism import Body, Joint, Part
-from mechc.pipeline import Design
 
 
 def strong_actuators(d: Design, rated_N: float = 1e6) -> Design:

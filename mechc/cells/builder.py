@@ -20,62 +20,17 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from mechc.ir.mechanism import GROUND, Body, Joint, Part, Point, Spring, Terminal
-
-
-@dataclass(frozen=True)
-class Demand:
-    """Force (N) needed to move a signal body towards on (``right``) and towards off (``left``),
-    beyond the body's own guide friction."""
-
-    right: float = 0.0
-    left: float = 0.0
-
-    def __add__(self, o: Demand) -> Demand:
-        return Demand(self.right + o.right, self.left + o.left)
-
-    def reversed(self) -> Demand:
-        return Demand(self.left, self.right)
-
-    def to_json(self) -> dict:
-        return {"right_N": round(self.right, 4), "left_N": round(self.left, 4)}
-
-
-@dataclass(frozen=True)
-class SynthContext:
-    """Design rules shared by all cells (mm, N, kg)."""
-
-    stroke: float = 20.0
-    friction: float = 0.02  # N, guide friction of every slider (Coulomb)
-    margin: float = 1.3  # spring preload >= margin x what it must move
-    min_preload: float = 0.2  # N
-    spring_range: float = 0.3  # k*S / preload: the force rises 30 % over the stroke
-    thickness: float = 3.0  # mm plate
-    density: float = 2.7e-6  # kg/mm^3 (aluminium)
-    damping_ratio: float = 0.4
-    overtravel: float = 0.02  # fraction of stroke a bar may pass its working range (a stop)
-
-    @property
-    def bar(self) -> float:
-        """Width of bars and sliders."""
-        return max(5.0, 0.3 * self.stroke)
-
-    @property
-    def pitch(self) -> float:
-        """Vertical distance between input rows inside a cell."""
-        return max(14.0, 0.9 * self.stroke)
-
-    @property
-    def arm(self) -> float:
-        """Lever arm (pivot to pin): 1.5 S keeps the swing at ±19.5° (transmission ≥ 70°)."""
-        return 1.5 * self.stroke
-
-    def mass(self, polys: list[list[Point]]) -> float:
-        return sum(abs(_area(p)) for p in polys) * self.thickness * self.density
-
-
-def _area(poly: list[Point]) -> float:
-    return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]))
+from mechc.ir.mechanism import (
+    GROUND,
+    Body,
+    Demand,
+    Joint,
+    Part,
+    Point,
+    Spring,
+    SynthContext,
+    Terminal,
+)
 
 
 def rect(x0: float, y0: float, x1: float, y1: float) -> list[Point]:

@@ -18,8 +18,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from mechc.cells.builder import Demand, SynthContext
-from mechc.ir.mechanism import Part
+from mechc.ir.mechanism import Demand, Part, SynthContext
+from mechc.physics.closed_form import solve
 
 
 @dataclass(frozen=True)
@@ -80,8 +80,6 @@ class Cell:
     @classmethod
     def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):
         """Poses of every body given the input terminal bodies' displacements (closed form)."""
-        from mechc.physics.closed_form import solve
-
         return solve(part, fixed, size, extra)
 
     @classmethod

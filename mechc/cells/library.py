@@ -61,6 +61,9 @@ class Library:
 
 _CACHE: dict[tuple[str, ...], Library] = {}
 
+#: The package of the standard cells (the repository's stdlib/ directory).
+STDLIB = "mechc.stdlib"
+
 
 def user_dirs(extra: Iterable[str] = ()) -> list[str]:
     env = os.environ.get("MECHC_CELLS", "")
@@ -72,13 +75,14 @@ def load_library(extra_dirs: Iterable[str] = ()) -> Library:
     if dirs in _CACHE:
         return _CACHE[dirs]
     found: dict[str, type[Cell]] = {}
-    import mechc.stdlib
-
-    for info in sorted(pkgutil.iter_modules(mechc.stdlib.__path__), key=lambda i: i.name):
+    # the standard cells are found by package name, like any plugin: the loader does not
+    # import them as a dependency (they import mechc.cells)
+    std = list(importlib.util.find_spec(STDLIB).submodule_search_locations)
+    for info in sorted(pkgutil.iter_modules(std), key=lambda i: i.name):
         if info.name.startswith("_"):
             continue
-        path = Path(mechc.stdlib.__path__[0]) / f"{info.name}.py"
-        mod = _guarded(path, lambda name=info.name: importlib.import_module(f"mechc.stdlib.{name}"))
+        path = Path(std[0]) / f"{info.name}.py"
+        mod = _guarded(path, lambda name=info.name: importlib.import_module(f"{STDLIB}.{name}"))
         _collect(mod, path, found)
     for d in dirs:
         p = Path(d)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
+from mechc.ir.check import Check
+
 Point = tuple[float, float]
 GROUND = "ground"
 
@@ -185,34 +187,6 @@ class Terminal:
 
 
 @dataclass
-class Check:
-    """A design check with the number that decides it."""
-
-    name: str
-    where: str
-    value: float
-    limit: float
-    sense: str  # ">=" or "<="
-    unit: str = ""
-
-    @property
-    def passed(self) -> bool:
-        v = self.value
-        if v != v:  # NaN never passes
-            return False
-        return bool(v >= self.limit if self.sense == ">=" else v <= self.limit)
-
-    def to_json(self) -> dict:
-        return {"name": self.name, "where": self.where, "value": round(float(self.value), 4),
-                "limit": self.limit, "sense": self.sense, "unit": self.unit,
-                "passed": self.passed}
-
-    def text(self) -> str:
-        return (f"{self.name} at {self.where}: {self.value:.4g}{self.unit} "
-                f"(limit {self.sense} {self.limit:g}{self.unit})")
-
-
-@dataclass
 class Part:
     """Bodies, joints and springs: a cell's mechanism, or the connecting parts of a net."""
 
@@ -250,3 +224,88 @@ def check_list_json(checks: list[Check]) -> list[dict]:
 
 def asjson(obj) -> dict:
     return asdict(obj)
+
+
+@dataclass(frozen=True)
+class Demand:
+    """Force (N) needed to move a signal body towards on (``right``) and towards off (``left``),
+    beyond the body's own guide friction."""
+
+    right: float = 0.0
+    left: float = 0.0
+
+    def __add__(self, o: Demand) -> Demand:
+        return Demand(self.right + o.right, self.left + o.left)
+
+    def reversed(self) -> Demand:
+        return Demand(self.left, self.right)
+
+    def to_json(self) -> dict:
+        return {"right_N": round(self.right, 4), "left_N": round(self.left, 4)}
+
+
+@dataclass(frozen=True)
+class SynthContext:
+    """Design rules shared by all cells (mm, N, kg)."""
+
+    stroke: float = 20.0
+    friction: float = 0.02  # N, guide friction of every slider (Coulomb)
+    margin: float = 1.3  # spring preload >= margin x what it must move
+    min_preload: float = 0.2  # N
+    spring_range: float = 0.3  # k*S / preload: the force rises 30 % over the stroke
+    thickness: float = 3.0  # mm plate
+    density: float = 2.7e-6  # kg/mm^3 (aluminium)
+    damping_ratio: float = 0.4
+    overtravel: float = 0.02  # fraction of stroke a bar may pass its working range (a stop)
+
+    @property
+    def bar(self) -> float:
+        """Width of bars and sliders."""
+        return max(5.0, 0.3 * self.stroke)
+
+    @property
+    def pitch(self) -> float:
+        """Vertical distance between input rows inside a cell."""
+        return max(14.0, 0.9 * self.stroke)
+
+    @property
+    def arm(self) -> float:
+        """Lever arm (pivot to pin): 1.5 S keeps the swing at ±19.5° (transmission ≥ 70°)."""
+        return 1.5 * self.stroke
+
+    def mass(self, polys: list[list[Point]]) -> float:
+        return sum(abs(_area(p)) for p in polys) * self.thickness * self.density
+
+
+def _area(poly: list[Point]) -> float:
+    return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]))
+
+
+@dataclass
+class Mechanism:
+    ctx: SynthContext
+    cells: dict[str, Part]  # placed cell mechanisms
+    inputs: dict[str, Part]  # input sliders (terminal pin = the input's name)
+    nets: dict[str, Part]  # rods of each net (joints between bodies of different parts)
+    outputs: dict[str, tuple[str, str]]  # output -> (owner: cell id or "in:NAME", pin)
+    actuators: dict[str, dict]  # input -> rating and requirement
+    order: list[str]  # cells in topological order
+    checks: list[Check] = field(default_factory=list)
+
+    def synthesis_checks(self) -> list[Check]:
+        """The checks decided when the mechanism was sized (forces), not by a kinematic sweep."""
+        return [c for c in self.checks if c.name in SYNTHESIS_CHECKS]
+
+    def owner_part(self, owner: str) -> Part:
+        return self.inputs[owner[3:]] if owner.startswith("in:") else self.cells[owner]
+
+    def all_parts(self):
+        yield from self.inputs.values()
+        yield from (self.cells[c] for c in self.order)
+        yield from self.nets.values()
+
+    def body_index(self) -> dict:
+        return {b.id: b for p in self.all_parts() for b in p.bodies}
+
+
+SYNTHESIS_CHECKS = ("actuator force", "force budget converged")

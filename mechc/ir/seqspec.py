@@ -260,24 +260,6 @@ class SeqSpec:
             d["start"] = format(self.start_inputs, f"0{self.n}b") if self.n else ""
         return d
 
-    @staticmethod
-    def from_json(d: dict, where: str = "<json>") -> SeqSpec:
-        from mechc.frontends.fsm import parse_expression
-
-        inputs, outputs = list(d["inputs"]), list(d["outputs"])
-        if "table" in d:
-            return SeqSpec(d.get("source", where), inputs, outputs,
-                           table=FlowTable.from_json(d["table"], inputs, outputs))
-        names = inputs + [m["name"] for m in d.get("memories", [])]
-        mems = [MemorySpec(m["name"], parse_expression(m["set"], names, where),
-                           parse_expression(m["reset"], names, where), int(m["initial"]))
-                for m in d.get("memories", [])]
-        eqs = {o: parse_expression(f["expr"], names, where)
-               for o, f in d.get("functions", {}).items()}
-        start = d.get("start") or ""
-        return SeqSpec(d.get("source", where), inputs, outputs, mems, eqs,
-                       start_inputs=int(start, 2) if start else 0)
-
     # ---- set/reset tables over (x, q) -------------------------------------------------------
     def sr_tables(self) -> dict[str, np.ndarray]:
         """Boolean tables over the total-state index (x << m) | q: ``S:name``, ``R:name`` per

@@ -112,26 +112,6 @@ class Spec:
         return {"source": self.path, "kind": self.kind, "inputs": list(self.inputs),
                 "outputs": list(self.outputs), "functions": funcs}
 
-    @staticmethod
-    def from_json(d: dict, where: str = "<json>") -> Spec:
-        from mechc.frontends.boolfile import parse_expression_text
-
-        inputs = list(d["inputs"])
-        funcs = {}
-        for name in d["outputs"]:
-            fd = d["functions"][name]
-            f = OutputSpec(name)
-            if "expr" in fd:
-                f.expr = parse_expression_text(fd["expr"], inputs, f"{where}: spec.{name}")
-            else:
-                f.on = [Cube.from_string(s) for s in fd.get("on", [])]
-            f.off = [Cube.from_string(s) for s in fd.get("off", [])]
-            f.dc = [Cube.from_string(s) for s in fd.get("dc", [])]
-            rest = fd.get("rest", 0)
-            f.rest = DC if rest == "dc" else int(rest)
-            funcs[name] = f
-        return Spec(d.get("source", where), d.get("kind", "bool"), inputs, list(d["outputs"]),
-                    funcs)
 
 
 def _in_cubes(cubes: list[Cube], bits: np.ndarray, n: int) -> np.ndarray:

@@ -111,3 +111,8 @@ def eval_cover(cubes: Sequence[Cube], rows: np.ndarray) -> np.ndarray:
     for c in cubes:
         out |= (rows & c.mask) == c.value
     return out
+
+
+def sort_cubes(cubes: list[Cube], n: int) -> list[Cube]:
+    """Print order: fewer literals first, then by literal pattern (deterministic)."""
+    return sorted(cubes, key=lambda c: (c.literals(), c.to_string(n).replace("-", "2")))

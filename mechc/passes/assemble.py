@@ -11,15 +11,16 @@ bar on its driver's output slider with one horizontal rod to each load (the rods
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-from mechc.cells.builder import Builder, Demand, SynthContext, rect
+from mechc.cells.builder import Builder, rect
 from mechc.cells.library import Library
 from mechc.errors import DesignError
 from mechc.geometry.transform import bounds, translate
-from mechc.ir.mechanism import Check, Joint, Part, Point, Terminal
+from mechc.ir.check import Check
+from mechc.ir.layout import Layout
+from mechc.ir.mechanism import Demand, Joint, Mechanism, Part, Point, SynthContext, Terminal
 from mechc.ir.netlist import Netlist
-from mechc.passes.place import Layout
 
 
 @dataclass
@@ -27,36 +28,6 @@ class MechOptions:
     stroke: float = 20.0
     actuator_force: float = 100.0  # N, rated force of each input actuator
     output_load: float = 0.5  # N, what each circuit output must move, either way
-
-
-@dataclass
-class Mechanism:
-    ctx: SynthContext
-    cells: dict[str, Part]  # placed cell mechanisms
-    inputs: dict[str, Part]  # input sliders (terminal pin = the input's name)
-    nets: dict[str, Part]  # rods of each net (joints between bodies of different parts)
-    outputs: dict[str, tuple[str, str]]  # output -> (owner: cell id or "in:NAME", pin)
-    actuators: dict[str, dict]  # input -> rating and requirement
-    order: list[str]  # cells in topological order
-    checks: list[Check] = field(default_factory=list)
-
-    def synthesis_checks(self) -> list[Check]:
-        """The checks decided when the mechanism was sized (forces), not by a kinematic sweep."""
-        return [c for c in self.checks if c.name in SYNTHESIS_CHECKS]
-
-    def owner_part(self, owner: str) -> Part:
-        return self.inputs[owner[3:]] if owner.startswith("in:") else self.cells[owner]
-
-    def all_parts(self):
-        yield from self.inputs.values()
-        yield from (self.cells[c] for c in self.order)
-        yield from self.nets.values()
-
-    def body_index(self) -> dict:
-        return {b.id: b for p in self.all_parts() for b in p.bodies}
-
-
-SYNTHESIS_CHECKS = ("actuator force", "force budget converged")
 
 
 def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mechc.ir.mechanism import GROUND, Check
-from mechc.passes.assemble import Mechanism
+from mechc.ir.check import Check
+from mechc.ir.mechanism import GROUND, Mechanism
 from mechc.physics.closed_form import Poses, position
 
 MIN_TRANSMISSION_DEG = 45.0

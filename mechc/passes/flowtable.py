@@ -35,6 +35,7 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 
 from mechc.errors import DesignError
 from mechc.ir import expr as ex
+from mechc.ir.equations import Equations
 from mechc.ir.seqspec import (
     FlowTable,
     SeqSpec,
@@ -45,7 +46,7 @@ from mechc.ir.seqspec import (
 )
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import DC, Cube, eval_cover
-from mechc.passes.minimise import Equations, MinimiseOptions, count_shared, minimise
+from mechc.passes.minimise import MinimiseOptions, count_shared, minimise
 
 #: Enumerate every compatible (for prime compatibles) up to this many; beyond, maximal only.
 MAX_COMPATIBLES = 5_000

@@ -9,12 +9,12 @@ to expanding each uncovered on-minterm to a prime and covering with those; such 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from mechc.errors import MechcError, UsageError
-from mechc.ir import expr as ex
+from mechc.ir.equations import Cover, Equations, XorForm
 from mechc.ir.spec import Spec
 from mechc.logic.cover import min_cover, share_covers
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
@@ -30,83 +30,6 @@ class MinimiseOptions:
     complements: bool = True  # also minimise each output's complement (for the mapper)
     alt_time_limit: float = 3.0  # seconds per program for those alternatives (never reported)
     hazard_free: bool = True  # also derive covers with consensus terms (see logic/hazards.py)
-
-
-@dataclass
-class Cover:
-    """A sum of products over the spec's inputs, with how it was obtained."""
-
-    cubes: list[Cube]
-    proven: bool  # proven minimum (terms, then literals)
-    method: str  # "exact" | "greedy" | "expand"
-    seconds: float = 0.0
-
-    @property
-    def terms(self) -> int:
-        return len(self.cubes)
-
-    @property
-    def literals(self) -> int:
-        return sum(c.literals() for c in self.cubes)
-
-
-@dataclass
-class XorForm:
-    """f = x_a ⊕ x_b ⊕ ... ⊕ g: the peeled inputs and the residual g (a cover or a constant)."""
-
-    vars: list[str]
-    residual: Cover | None
-    residual_complement: Cover | None
-    constant: int | None = None  # residual is this constant
-
-    def residual_keys(self, planner, inputs):
-        """Candidate structures for g as (key, invert-result) pairs for the mapper."""
-        if self.constant is not None:
-            return [(None, self.constant == 1)]
-        out = [(planner.sop(self.residual, inputs), False)]
-        if self.residual_complement is not None:
-            out.append((planner.sop(self.residual_complement, inputs, invert=True), False))
-        return out
-
-
-@dataclass
-class Equations:
-    inputs: list[str]
-    outputs: list[str]
-    covers: dict[str, Cover]
-    complements: dict[str, Cover] = field(default_factory=dict)  # covers of the complements
-    xor_forms: dict[str, XorForm] = field(default_factory=dict)
-    # the covers with consensus terms added (no static-1 hazard under single-input changes);
-    # the mapper builds these; ``covers`` stay the minimum the equations report
-    hazard_free: dict[str, Cover] = field(default_factory=dict)
-    hazard_free_complements: dict[str, Cover] = field(default_factory=dict)
-    shared_terms: int = 0  # product terms used by more than one output
-
-    def expr(self, name: str, complement: bool = False) -> ex.Expr:
-        cover = (self.complements if complement else self.covers)[name]
-        n = len(self.inputs)
-        return ex.sop([[(self.inputs[k], pos) for k, pos in c.literal_list(n)]
-                       for c in sort_cubes(cover.cubes, n)])
-
-    def text(self, name: str) -> str:
-        return ex.to_text(self.expr(name))
-
-    @property
-    def literals(self) -> int:
-        return sum(c.literals for c in self.covers.values())
-
-    @property
-    def terms(self) -> int:
-        return sum(c.terms for c in self.covers.values())
-
-    @property
-    def proven(self) -> bool:
-        return all(c.proven for c in self.covers.values())
-
-
-def sort_cubes(cubes: list[Cube], n: int) -> list[Cube]:
-    """Print order: fewer literals first, then by literal pattern (deterministic)."""
-    return sorted(cubes, key=lambda c: (c.literals(), c.to_string(n).replace("-", "2")))
 
 
 def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:

@@ -7,35 +7,10 @@ geometry can widen them.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
+from mechc.ir.layout import Layout, Place
 from mechc.ir.netlist import Netlist, in_node
-
-
-@dataclass(frozen=True)
-class Place:
-    x: float
-    y: float
-    column: int
-    row: int
-
-    def to_json(self) -> dict:
-        return {"x": round(self.x, 3), "y": round(self.y, 3), "column": self.column,
-                "row": self.row}
-
-
-@dataclass
-class Layout:
-    cells: dict[str, Place]
-    inputs: dict[str, Place]
-    pitch: tuple[float, float]
-    crossings: int
-
-    def to_json(self) -> dict:
-        return {"pitch_mm": list(self.pitch), "crossings": self.crossings,
-                "inputs": {k: v.to_json() for k, v in self.inputs.items()}}
 
 
 def place(nl: Netlist, pitch: tuple[float, float] = (140.0, 90.0), sweeps: int = 8) -> Layout:

@@ -20,8 +20,10 @@ from dataclasses import replace
 import numpy as np
 
 from mechc.cells.library import Library
+from mechc.errors import DesignError
+from mechc.ir.equations import Equations
 from mechc.ir.netlist import CellInst, Netlist
-from mechc.passes.minimise import Equations
+from mechc.passes.map_sop import Mapped, map_sop
 from mechc.threshold.functions import depends_on
 from mechc.threshold.weights import Realisation, realise
 
@@ -73,15 +75,11 @@ def parts(nl: Netlist, library: Library) -> int:
 
 def build(eq: Equations, library: Library, opts, chosen: dict[str, tuple[list[str], Realisation]]):
     """Conventional netlist for the other outputs, plus one THRESHOLD cell per chosen output."""
-    from mechc.passes.map import Mapped, map_equations
-
     rest = [o for o in eq.outputs if o not in chosen]
-    conv = map_equations(replace(eq, outputs=rest), library, replace(opts, target="conventional"))
+    conv = map_sop(replace(eq, outputs=rest), library, replace(opts, target="conventional"))
     nl = conv.netlist
     cls = library.for_type("THRESHOLD", MAX_INPUTS)
     if cls is None and chosen:
-        from mechc.errors import DesignError
-
         raise DesignError("the cell library has no THRESHOLD cell")
     taken = set(nl.driver) | set(eq.outputs)
     implemented = dict(conv.implemented)

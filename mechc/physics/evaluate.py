@@ -6,12 +6,19 @@ of each net carry a driver's output slider to its loads' input sliders.
 
 from __future__ import annotations
 
+from typing import Any, Protocol
+
 import numpy as np
 
-from mechc.cells.library import Library
-from mechc.ir.mechanism import Body, Terminal
-from mechc.passes.assemble import Mechanism
+from mechc.ir.mechanism import Body, Mechanism, Terminal
 from mechc.physics.closed_form import Poses, _slider_from_rod, position
+
+
+class CellModels(Protocol):
+    """What the physics asks of a cell library: the cell class of a name, whose
+    ``kinematics`` and ``build_dynamics`` it calls (``mechc.cells.library.Library`` is one)."""
+
+    def __getitem__(self, name: str) -> Any: ...
 
 
 def signal_of(t: Terminal, body: Body, poses: Poses) -> np.ndarray:
@@ -21,7 +28,7 @@ def signal_of(t: Terminal, body: Body, poses: Poses) -> np.ndarray:
     return ((x - t.off[0]) * dx + (y - t.off[1]) * dy) / (dx * dx + dy * dy)
 
 
-def evaluate(mech: Mechanism, lib: Library, cell_types: dict[str, str],
+def evaluate(mech: Mechanism, lib: CellModels, cell_types: dict[str, str],
              values: dict[str, np.ndarray],
              state: dict[str, np.ndarray] | None = None) -> Poses:
     """Poses of every body for input signal values (0..1 arrays, one per input).
@@ -68,7 +75,7 @@ def evaluate(mech: Mechanism, lib: Library, cell_types: dict[str, str],
     return poses
 
 
-def settle(mech: Mechanism, lib: Library, cell_types: dict[str, str],
+def settle(mech: Mechanism, lib: CellModels, cell_types: dict[str, str],
            values: dict[str, np.ndarray], state: dict[str, np.ndarray] | None = None,
            max_rounds: int = 16) -> tuple[Poses, dict[str, np.ndarray], np.ndarray]:
     """Fundamental mode in closed form: evaluate, let the stateful cells take their new

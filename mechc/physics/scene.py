@@ -30,11 +30,9 @@ import numpy as np
 import pymunk
 import pymunk.batch as pb
 
-from mechc.cells.library import Library
-from mechc.ir.mechanism import GROUND, Body
-from mechc.passes.assemble import Mechanism
+from mechc.ir.mechanism import GROUND, Body, Mechanism
 from mechc.physics.closed_form import Poses
-from mechc.physics.evaluate import settle
+from mechc.physics.evaluate import CellModels, settle
 
 N = 1000.0  # newtons -> pymunk force units (kg mm / s^2)
 FAR = 1000.0  # mm: how far behind a contact face its slide-joint anchor sits
@@ -95,7 +93,7 @@ class _J:
 @dataclass
 class Scene:
     mech: Mechanism
-    lib: Library
+    lib: CellModels
     types: dict[str, str]
     settings: DynSettings
     cells: list[str]
@@ -115,7 +113,7 @@ class Scene:
 
     # ---- building ---------------------------------------------------------------------------
     @staticmethod
-    def build(mech: Mechanism, lib: Library, types: dict[str, str], settings: DynSettings,
+    def build(mech: Mechanism, lib: CellModels, types: dict[str, str], settings: DynSettings,
               start: dict[str, float], cells: list[str] | None = None,
               poses: Poses | None = None) -> Scene:
         """``poses``: the closed form of ``start`` if the caller has it (its first sample is

@@ -23,11 +23,11 @@ import numpy as np
 
 from mechc.cells.library import Library
 from mechc.errors import UsageError
+from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
 from mechc.passes.checks import CheckStats
 from mechc.physics.scene import DynSettings, Scene
-from mechc.pipeline import Design
 from mechc.proofs.cases import gray_tour, random_walk
 from mechc.proofs.kinematic import sweep
 from mechc.proofs.logic import check_interface

@@ -45,8 +45,8 @@ import numpy as np
 import pymunk
 
 from mechc.cells.library import Library
+from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
-from mechc.passes.assemble import Mechanism
 from mechc.physics.closed_form import Poses
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.physics.scene import MOVE_SAMPLES, DynSettings, MoveResult, Scene

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 from mechc.stdlib.threshold import ThresholdCell, truth_table
 
-from mechc.cells.builder import Demand, SynthContext
 from mechc.cells.library import load_library
 from mechc.frontends.boolfile import parse_bool
 from mechc.ir.logic_types import evaluate_type
+from mechc.ir.mechanism import Demand, SynthContext
 from mechc.passes.map import MapOptions, map_equations
 from mechc.passes.minimise import minimise
 from mechc.physics.evaluate import signal_of
