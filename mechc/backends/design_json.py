@@ -1,4 +1,5 @@
-"""The output writer: Design <-> JSON (validated against the shipped schema), atomic file writes."""
+"""The design JSON back end: Design <-> JSON (validated against the shipped schema; the
+mechanism geometry of every cell and the top-level ``mechanism``), written atomically."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ import json
 import math
 import os
 import tempfile
+from dataclasses import asdict, fields
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -13,9 +15,10 @@ from pathlib import Path
 from mechc import FORMAT_VERSION, __version__
 from mechc.errors import SpecError, UsageError
 from mechc.frontends.spec_json import seqspec_from_json, spec_from_json
+from mechc.ir.check import Check
 from mechc.ir.design import Design
 from mechc.ir.layout import Layout, Place
-from mechc.ir.mechanism import GROUND
+from mechc.ir.mechanism import GROUND, Mechanism, Part, SynthContext
 from mechc.ir.netlist import Netlist
 from mechc.ir.seqspec import SequentialError
 
@@ -51,7 +54,6 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
         "stats": stats,
     }
     if mech is not None:
-        from mechc.backends.mechanism_json import mechanism_json
 
         out["mechanism"] = mechanism_json(mech)
     if getattr(d, "sequential", None) is not None:
@@ -277,7 +279,6 @@ def design_from_json(obj: dict, where: str = "<json>") -> Design:
             raise UsageError(f"{where}: inconsistent layout: {_why(e)}") from None
     mech = None
     if obj.get("mechanism"):
-        from mechc.backends.mechanism_json import mechanism_from_json
 
         try:
             mech = mechanism_from_json(obj["mechanism"], obj["cells"])
@@ -301,3 +302,29 @@ def _why(e: Exception) -> str:
     if isinstance(e, KeyError):
         return f"missing or unknown {e.args[0]!r}" if e.args else "missing entry"
     return str(e) or type(e).__name__
+
+
+def mechanism_json(m: Mechanism) -> dict:
+    return {
+        "stroke_mm": m.ctx.stroke,
+        "rules": {k: v for k, v in asdict(m.ctx).items()},
+        "order": list(m.order),
+        "inputs": {k: p.to_json() for k, p in m.inputs.items()},
+        "actuators": m.actuators,
+        "nets": {k: p.to_json() for k, p in sorted(m.nets.items())},
+        "outputs": {k: {"owner": o, "pin": p} for k, (o, p) in m.outputs.items()},
+        "checks": [c.to_json() for c in m.checks],
+    }
+
+
+def mechanism_from_json(d: dict, cells: list[dict]) -> Mechanism:
+    names = {f.name for f in fields(SynthContext)}
+    ctx = SynthContext(**{k: v for k, v in d.get("rules", {}).items() if k in names})
+    cell_parts = {c["id"]: Part.from_json(c["geometry"]) for c in cells if "geometry" in c}
+    checks = [Check(c["name"], c["where"], float(c["value"]), float(c["limit"]), c["sense"],
+                    c.get("unit", "")) for c in d.get("checks", [])]
+    return Mechanism(ctx, cell_parts,
+                     {k: Part.from_json(p) for k, p in d["inputs"].items()},
+                     {k: Part.from_json(p) for k, p in d["nets"].items()},
+                     {k: (v["owner"], v["pin"]) for k, v in d["outputs"].items()},
+                     dict(d.get("actuators", {})), list(d["order"]), checks)

@@ -751,10 +751,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_arguments(p)
-    return _run_args(p.parse_args(argv))
+    return run_args(p.parse_args(argv))
 
 
-def _run_args(args) -> int:
+def run_args(args: argparse.Namespace) -> int:
+    """The benchmark as the command line asks for it (``mechc bench`` and the script)."""
     model = args.write_model
     if model is None and not args.quick and not args.no_model:
         model = str(MODEL_PATH)
@@ -762,11 +763,3 @@ def _run_args(args) -> int:
         model = None
     run(args.quick, Path(args.out), Path(model) if model else None)
     return 0
-
-
-def register(sub) -> None:
-    """``mechc bench``."""
-    p = sub.add_parser("bench", help="speed against accuracy benchmark (CSV + charts)",
-                       description=__doc__.split("\n\n")[0])
-    add_arguments(p)
-    p.set_defaults(func=_run_args)

@@ -10,10 +10,17 @@ import argparse
 import json
 import math
 import textwrap
+from dataclasses import replace
 
 import numpy as np
 
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mechc.linkage_synthesis import three_bar as tb
+from mechc.linkage_synthesis.adders import LongBarAdder, bar_shortening, long_bar_adder
+from mechc.linkage_synthesis.defects import check_dyads
+from mechc.linkage_synthesis.examples import EXAMPLES
+from mechc.linkage_synthesis.mk_circles import ANGLE_NAMES, SynthesisError, solve_chain
+from mechc.linkage_synthesis.positions import load_positions
 from mechc.ui import finite_float, int_at_least
 
 SYNTH_DESCRIPTION = """\
@@ -188,8 +195,6 @@ def _range(text: str) -> tuple[float, float]:
 
 
 def _example_names(kind: str) -> list[str]:
-    from mechc.linkage_synthesis.examples import EXAMPLES
-
     k = 2 if kind == "dyad" else 3
     return [n for n, e in EXAMPLES.items() if e.problem.k == k]
 
@@ -217,14 +222,13 @@ def _jsonable(o):
 
 
 def cmd_three_bar(args) -> int:
-    from mechc.linkage_synthesis import three_bar as tb
-
     cr = tb.Criteria(args.min_angle, args.min_link_ratio, args.max_wander)
     ans = tb.synthesise(args.sep, args.stroke, args.output, cr,
                         alternatives=not args.no_alternatives)
     out = ans.to_json()
     out["request"] = {"sep": args.sep, "stroke": args.stroke, "output": args.output}
     if args.plot:
+        # matplotlib loads only when a plot is asked for (start-up time)
         from mechc.linkage_synthesis.plots import plot_three_bar
 
         seps = np.geomspace(args.sep / 4, args.sep * 4, 25)
@@ -269,9 +273,6 @@ def _print_three_bar(ans, args) -> None:
 
 
 def _problem(args):
-    from mechc.linkage_synthesis.examples import EXAMPLES
-    from mechc.linkage_synthesis.positions import load_positions
-
     if args.example and args.positions:
         raise UsageError("give a positions file or --example, not both")
     if args.example:
@@ -291,10 +292,6 @@ def _problem(args):
 
 
 def _apply_free(pr, items: list[str]):
-    from dataclasses import replace
-
-    from mechc.linkage_synthesis.mk_circles import ANGLE_NAMES
-
     if not items:
         return pr
     ang = pr.angles.copy()
@@ -316,8 +313,6 @@ def _apply_free(pr, items: list[str]):
 
 
 def cmd_chain(args) -> int:
-    from mechc.linkage_synthesis.mk_circles import SynthesisError, solve_chain
-
     pr = _problem(args)
     try:
         res = solve_chain(pr, grid=args.grid)
@@ -336,13 +331,13 @@ def cmd_chain(args) -> int:
     if res.family:
         out["family"] = [s.to_json() for s in res.family]
     if args.kind == "dyad" and getattr(args, "defects", False):
-        from mechc.linkage_synthesis.defects import check_dyads
 
         out["fourbars"] = [
             {"dyads": [i + 1, j + 1], "defects": check_dyads(res.solutions[i],
                                                              res.solutions[j]).to_json()}
             for i in range(len(res.solutions)) for j in range(len(res.solutions)) if i != j]
     if args.plot:
+        # matplotlib loads only when a plot is asked for (start-up time)
         from mechc.linkage_synthesis.plots import plot_chain
 
         plot_chain(res, args.plot)
@@ -382,8 +377,6 @@ def _print_chain(res, out, args) -> None:
 
 
 def cmd_adder(args) -> int:
-    from mechc.linkage_synthesis.adders import LongBarAdder, bar_shortening, long_bar_adder
-
     w1, w2 = args.weights
     lever = args.lever
     wsum = w1 + w2
@@ -412,6 +405,7 @@ def cmd_adder(args) -> int:
         "bound_eq15": bound,
     }
     if args.plot:
+        # matplotlib loads only when a plot is asked for (start-up time)
         from mechc.linkage_synthesis.plots import plot_adder
 
         plot_adder(X1, X2, err, args.plot)

@@ -1,0 +1,127 @@
+"""What several commands share: the compile options, reading a spec or a design, and
+refusing an output path that would overwrite an input."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from mechc.backends.design_json import check_writable, design_from_json, load_design_json
+from mechc.errors import UsageError
+from mechc.frontends import load_spec
+from mechc.ir.design import Design
+from mechc.passes.assemble import MechOptions
+from mechc.passes.map import MapOptions
+from mechc.passes.minimise import MinimiseOptions
+from mechc.pipeline import CompileOptions, compile_sequential, compile_spec
+from mechc.ui import finite_float, int_at_least
+
+__all__ = ["by_type", "check_output", "compile_options", "compile_path", "load_design_or_spec",
+           "load_spec", "options_from_args"]
+
+
+def compile_options(c: argparse.ArgumentParser) -> None:
+    """The options every command that compiles a spec takes (compile, simulate, draw)."""
+    g = c.add_argument_group("compilation")
+    g.add_argument("--cells", dest="cell_dirs", action="append", default=[], metavar="DIR",
+                   help="extra directory of cell files (repeatable; also MECHC_CELLS)")
+    g.add_argument("--use-cell", dest="use_cell", action="append", default=[], metavar="NAME",
+                   help="use library cell NAME wherever it fits, also one the mapper does not "
+                   "choose by itself (e.g. three_bar_and; repeatable)")
+    g.add_argument("--fan-in", type=int_at_least(2), default=None, metavar="N",
+                   help="at most N inputs per AND/OR/NAND/NOR cell (default: the library's)")
+    g.add_argument("--time-limit", type=finite_float, default=20.0, metavar="S",
+                   help="seconds per exact-cover program before the best cover found is used "
+                   "and reported as not proven minimal (default: %(default)s)")
+    g.add_argument("--phase", choices=["auto", "sop"], default="auto",
+                   help="auto: also try complement (NOR/NAND root) and XOR forms and keep the "
+                   "cheapest; sop: sums of products only (default: %(default)s)")
+    g.add_argument("--map", dest="map_target", choices=["conventional", "threshold", "auto"],
+                   default="conventional",
+                   help="threshold: outputs of up to 3 inputs as THRESHOLD generators (001 Ch. "
+                   "III); auto: only where that costs fewer parts (default: %(default)s)")
+    g.add_argument("--no-share", action="store_true",
+                   help="do not share product terms between outputs")
+    g.add_argument("--keep-hazards", action="store_true",
+                   help="build the minimum covers as they are, without consensus terms (outputs "
+                   "may then dip during single-input changes)")
+    m = c.add_argument_group("mechanism")
+    m.add_argument("--stroke", type=finite_float, default=20.0, metavar="MM",
+                   help="stroke of every terminal, off to on (default: %(default)s mm)")
+    m.add_argument("--actuator-force", type=finite_float, default=100.0, metavar="N",
+                   help="rated force of each input actuator (default: %(default)s N)")
+    m.add_argument("--output-load", type=finite_float, default=0.5, metavar="N",
+                   help="force each circuit output must move either way (default: %(default)s N)")
+    m.add_argument("--no-amplify", action="store_true",
+                   help="never insert AMPLIFIER cells by itself (by default they go where an "
+                   "actuator or a MEMORY loop is short of force, and before a sequential output "
+                   "that would move partway while a memory switches); the design checks then "
+                   "report what fails")
+
+
+def options_from_args(args: argparse.Namespace) -> CompileOptions:
+    """The pipeline's options from the command line, each range checked."""
+    if args.time_limit <= 0:
+        raise UsageError("--time-limit must be positive")
+    if not 1.0 <= args.stroke <= 500.0:
+        raise UsageError("--stroke must be between 1 and 500 mm")
+    if args.actuator_force <= 0 or args.output_load < 0:
+        raise UsageError("--actuator-force must be positive and --output-load not negative")
+    return CompileOptions(
+        minimise=MinimiseOptions(time_limit=args.time_limit, share=not args.no_share,
+                                 complements=args.phase == "auto",
+                                 hazard_free=not args.keep_hazards),
+        map=MapOptions(fan_in=args.fan_in, phase=args.phase,
+                       hazard_free=not args.keep_hazards,
+                       prefer=tuple(getattr(args, "use_cell", ())),
+                       target=getattr(args, "map_target", "conventional")),
+        mech=MechOptions(stroke=args.stroke, actuator_force=args.actuator_force,
+                         output_load=args.output_load),
+        cell_dirs=tuple(args.cell_dirs),
+        amplify=not getattr(args, "no_amplify", False),
+        timings=getattr(args, "timings", False),
+    )
+
+
+def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = True) -> Design:
+    """Compile a spec file in memory (``mechanism=False``: a sequential spec stops after
+    placement, all its logic proof needs)."""
+    spec = load_spec(spec_path)
+    if not mechanism and getattr(spec, "kind", "") == "fsm":
+        return compile_sequential(spec, options_from_args(args), mechanism=False)
+    return compile_spec(spec, options_from_args(args))
+
+
+def check_output(out: str, what: str, inputs: list[tuple[str, str | None]]) -> None:
+    """Refuse an output path that would overwrite an input or cannot be written, before any
+    work is done (the write itself is atomic: see
+    :func:`mechc.backends.design_json.write_atomic`)."""
+    for kind, path in inputs:
+        if path and (Path(out).resolve() == Path(path).resolve() or same_file(out, path)):
+            raise UsageError(f"refusing to overwrite the {kind} '{path}' with the {what}")
+    check_writable(out)
+
+
+def same_file(a: str, b: str) -> bool:
+    """Also a hard link, which resolve() does not see through."""
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist (yet)
+        return False
+
+
+def by_type(d: dict) -> str:
+    """'2 AND, 1 OR': cells by logic type, for summaries."""
+    return ", ".join(f"{v} {k}" for k, v in d.items()) or "none"
+
+
+def load_design_or_spec(path: str, args: argparse.Namespace) -> Design:
+    """A compiled design (.json), or a spec compiled in memory."""
+    if path.lower().endswith(".json"):
+        return design_from_json(load_design_json(path), path)
+    # a logic proof of a sequential spec needs the netlist only, not the mechanism
+    return compile_path(path, args, mechanism=getattr(args, "level", None) != "logic")
+
+
+#: simulate's options that set the pymunk solver (DynSettings fields of the same names).

@@ -1,0 +1,81 @@
+"""``mechc compile``: a spec becomes a design JSON, with a summary on the terminal."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from mechc.backends.design_json import design_to_json, dumps, validate, write_atomic
+from mechc.cli.common import by_type, check_output, compile_options, compile_path
+from mechc.errors import EXIT_FAILED, EXIT_OK
+
+
+def register(sub) -> None:
+    c = sub.add_parser("compile", help="compile a spec to a netlist JSON",
+                       description="Parse SPEC (.bool or .pla), minimise every output exactly, "
+                       "map to library cells, place them, and write the design as JSON. The "
+                       "output file is written atomically: on any error an existing file is "
+                       "left untouched.")
+    c.add_argument("spec", help="specification file (.bool, .pla, .fsm)")
+    c.add_argument("-o", "--output", help="output JSON file (default: SPEC with .json suffix)")
+    compile_options(c)
+    c.add_argument("--timings", action="store_true",
+                   help="record seconds per stage in stats.seconds (the file then differs "
+                   "from run to run)")
+    c.add_argument("--print-netlist", action="store_true",
+                   help="also print the netlist in canonical text form")
+    c.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    out = args.output or str(Path(args.spec).with_suffix(".json"))
+    check_output(out, "output", [("spec", args.spec)])
+    t0 = time.perf_counter()
+    design = compile_path(args.spec, args)
+    obj = design_to_json(design, timings=args.timings)
+    validate(obj, out)
+    write_atomic(out, dumps(obj))
+    st = design.stats
+    methods = {v["method"] for v in st["minimisation"]["outputs"].values()}
+    if st["minimisation"]["proven"]:
+        how = "minimum proven"
+    elif "espresso" in methods:
+        how = "heuristic cover (espresso-style, wide PLA): not proven minimal"
+    else:
+        how = "minimum NOT proven (time limit or too many primes)"
+    print(f"{args.spec} -> {out}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
+          f"{st['parts']} parts, {st['literals']} literals, {how}, "
+          f"{time.perf_counter() - t0:.2f} s")
+    for o in design.spec.outputs:
+        print(f"  {o} = {design.equations[o]}")
+        if design.implemented.get(o) and design.implemented[o] != design.equations[o]:
+            print(f"  {' ' * len(o)}   built as {design.implemented[o]}")
+    se = getattr(design, "sequential", None)
+    if se is not None:
+        for m in se.memories:
+            print(f"  MEMORY {m}: set = {se.text(se.set_names[m])}, reset = "
+                  f"{se.text(se.reset_names[m])}, initial {se.initial[m]}")
+        if se.checked.get("sr_overlap_total_states"):
+            print(f"  note: SET and RESET of a memory are both on in "
+                  f"{se.checked['sr_overlap_total_states']} total state(s) that the spec never "
+                  "reaches (every reachable one was checked)")
+        for h in se.essential_hazards:
+            print(f"  essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
+                  f"{h['to']}: {h['requires']}")
+    for net, why in st.get("amplified", {}).items():
+        print(f"  AMPLIFIER on {net}: {why}")
+    if args.print_netlist:
+        print(design.netlist.to_text(), end="")
+    dc = st.get("design_checks", {})
+    if dc and not dc["passed"]:
+        print(f"DESIGN CHECKS FAILED ({len(dc['failed'])} of {dc['count']}); the design was "
+              f"written to {out} for inspection:", file=sys.stderr)
+        for text in dc["failed"][:20]:
+            print(f"  {text}", file=sys.stderr)
+        return EXIT_FAILED
+    if dc:
+        print(f"  design checks: {dc['count']} passed (min transmission angle "
+              f"{dc['min_transmission_angle_deg']}°)")
+    return EXIT_OK
