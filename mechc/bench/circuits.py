@@ -13,6 +13,7 @@ import numpy as np
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube, input_matrix
+from mechc.pipeline import compile_spec
 
 TYPES = ["AND", "OR", "NAND", "NOR", "AND_NOT", "OR_NOT", "NOT"]
 CELL_OF = {"AND": "and", "OR": "or", "NAND": "nand", "NOR": "nor", "AND_NOT": "and_not",
@@ -71,8 +72,6 @@ def spec_of(nl: Netlist, name: str = "random") -> Spec:
 def random_compiled(target_cells: int, seed: int = 0, options=None):
     """A design compiled by mechc from a random spec, grown until it has about
     ``target_cells`` cells (±25 %): hazard-free, as every compiled design is."""
-    from mechc.pipeline import compile_spec
-
     rng = np.random.default_rng(seed)
     n_in, n_out = 4, 1
     best = None

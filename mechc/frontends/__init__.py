@@ -3,43 +3,37 @@ or a :class:`~mechc.ir.seqspec.SeqSpec` (sequential: .fsm, .kiss2)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from mechc.errors import SpecError
+from mechc.frontends.blif import parse_blif_file
+from mechc.frontends.boolfile import parse_bool_file
+from mechc.frontends.fsm import parse_fsm_file
+from mechc.frontends.kiss2 import parse_kiss_file
+from mechc.frontends.pla import parse_pla_file
+from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import OutputSpec, Spec
 
-if TYPE_CHECKING:
-    from mechc.ir.seqspec import SeqSpec
+__all__ = ["FRONT_ENDS", "OutputSpec", "SPEC_SUFFIXES", "Spec", "load_spec"]
 
-__all__ = ["OutputSpec", "Spec", "load_spec", "SPEC_SUFFIXES"]
-
-SPEC_SUFFIXES = (".bool", ".pla", ".blif", ".fsm", ".kiss2", ".kiss")
+#: Spec file suffix -> the front end that parses it (a new format: a module here and a line).
+FRONT_ENDS: dict[str, Callable[[str], Spec | SeqSpec]] = {
+    ".bool": parse_bool_file,
+    ".pla": parse_pla_file,
+    ".blif": parse_blif_file,
+    ".fsm": parse_fsm_file,
+    ".kiss2": parse_kiss_file,
+    ".kiss": parse_kiss_file,
+}
+SPEC_SUFFIXES = tuple(FRONT_ENDS)
 
 
 def load_spec(path: str | Path) -> Spec | SeqSpec:
     """Parse a spec file, choosing the front end by suffix."""
     p = Path(path)
     suffix = p.suffix.lower()
-    if suffix == ".bool":
-        from mechc.frontends.boolfile import parse_bool_file
-
-        return parse_bool_file(str(p))
-    if suffix == ".pla":
-        from mechc.frontends.pla import parse_pla_file
-
-        return parse_pla_file(str(p))
-    if suffix == ".blif":
-        from mechc.frontends.blif import parse_blif_file
-
-        return parse_blif_file(str(p))
-    if suffix == ".fsm":
-        from mechc.frontends.fsm import parse_fsm_file
-
-        return parse_fsm_file(str(p))
-    if suffix in (".kiss2", ".kiss"):
-        from mechc.frontends.kiss2 import parse_kiss_file
-
-        return parse_kiss_file(str(p))
+    if suffix in FRONT_ENDS:
+        return FRONT_ENDS[suffix](str(p))
     raise SpecError(str(p), 1, 1, f"unknown spec format '{suffix or p.name}': expected one of "
                     f"{', '.join(SPEC_SUFFIXES)}")

@@ -9,7 +9,7 @@ to expanding each uncovered on-minterm to a prime and covering with those; such 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -19,6 +19,7 @@ from mechc.ir.spec import Spec
 from mechc.logic.cover import min_cover, share_covers
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
 from mechc.logic.espresso import check_cover, espresso
+from mechc.logic.hazards import hazard_free
 from mechc.logic.primes import TooManyPrimes, prime_implicants
 
 
@@ -91,8 +92,6 @@ def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
 
 
 def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts) -> Cover:
-    from mechc.logic.hazards import hazard_free
-
     if primes is None:
         return cover
     masks, values, _on, _dc = primes
@@ -112,8 +111,6 @@ def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
     small, otherwise a heuristic prime cover (these are never reported as the minimum)."""
     if n <= ALT_EXACT_MAX_INPUTS:
         return _minimise_table(table, n, _alt(opts))
-    from mechc.logic.espresso import espresso
-
     t0 = time.perf_counter()
     onm = np.flatnonzero(table == 1).astype(np.int64)
     if not len(onm):
@@ -134,8 +131,6 @@ def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
 
 def _alt(opts: MinimiseOptions) -> MinimiseOptions:
     """Options for the alternative forms the mapper may try (shorter time limit)."""
-    from dataclasses import replace
-
     return replace(opts, time_limit=min(opts.time_limit, opts.alt_time_limit))
 
 
