@@ -20,6 +20,7 @@ from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
 from mechc.passes.assemble import MechOptions, synthesise_mechanism
+from mechc.passes.checks import run_design_checks
 from mechc.passes.map import MapOptions, map_equations
 from mechc.passes.minimise import MinimiseOptions, minimise
 from mechc.passes.place import place
@@ -188,44 +189,6 @@ def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = 
     design = Design(spec, {}, {}, netlist, layout, stats, {}, None, mech)
     run_design_checks(design, lib)
     return design
-
-
-def run_design_checks(design: Design, lib: Library) -> None:
-    """Measure the design checks on the closed-form kinematics (every input state and every
-    single-input change up to 10 inputs) and record them in the mechanism and the stats."""
-    from mechc.passes.checks import CheckStats
-    from mechc.proofs.kinematic import sweep
-
-    mech = design.mechanism
-    stats = CheckStats(mech)
-    wide = len(design.netlist.inputs) > 10
-    # a budget of cell-states, so a big design is checked on a sample (the kinematic proof,
-    # `mechc simulate --level kinematic`, remains exhaustive up to 10 inputs)
-    budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
-    sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
-    measured = stats.checks()
-    if design.sequential is not None:
-        measured += _memory_checks(design, lib, stats)
-    mech.checks = mech.synthesis_checks() + measured
-    failed = [c for c in mech.checks if not c.passed]
-    mus = [c.value for c in mech.checks if c.name == "transmission angle"]
-    design.stats["design_checks"] = {
-        "passed": not failed, "count": len(mech.checks), "failed": [c.text() for c in failed],
-        "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
-    }
-
-
-def _memory_checks(design: Design, lib: Library, stats) -> list:
-    """A sequential design is also walked through every specified transition (the kinematic
-    sequential proof): each MEMORY's SET and RESET must never press its lever together."""
-    from mechc.ir.check import Check
-    from mechc.proofs.seq_mechanism import prove_sequential_kinematic
-
-    r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)
-    per_cell = r["overlaps_by_cell"]
-    mems = [c.id for c in design.netlist.cells.values() if c.type == "MEMORY"]
-    return [Check("SET and RESET apart (transitions where both press)", f"MEMORY {c}",
-                  float(per_cell.get(c, 0)), 0.0, "<=") for c in mems]
 
 
 def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None) -> dict:

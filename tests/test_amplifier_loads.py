@@ -13,7 +13,6 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mechc.cells.library import load_library
-from mechc.errors import DesignError
 from mechc.frontends.boolfile import parse_bool
 from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
@@ -72,21 +71,36 @@ def _inertia(part) -> float:
 def test_landing_check_flags_an_undamped_heavy_amplifier_and_bounds_the_damped_one():
     from mechc.stdlib.amplifier import (
         LANDING_RATIO,
+        MAX_LANDING_RATIO,
         SNAP_WORK_LIMIT,
         AmpDesign,
         landing_speed,
+        roller_matched_speed,
         snap_work,
     )
 
     cls = LIB["amplifier"]
-    # without a dashpot the heavy design is refused, the light one is not (and gets none)
-    with pytest.raises(DesignError, match="slam"):
-        cls.synthesise("a", CTX, 1, {"landing_ratio": 0}, HEAVY)
+    # without a dashpot the heavy design fails its landing check, the light one has none to
+    # fail (and gets no dashpot)
+    bare = cls.synthesise("a", CTX, 1, {"landing_ratio": 0}, HEAVY)
+    (slam,) = cls.checks("a", bare, CTX)
+    assert slam.where == "amplifier a" and "slam" in slam.name
+    assert slam.value == snap_work(AmpDesign(**bare.data["design"])) > SNAP_WORK_LIMIT
+    assert slam.limit == SNAP_WORK_LIMIT and not slam.passed
     light = cls.synthesise("a", CTX, 1, {}, Demand(0.5, 0.5))
     assert light.data["design"]["dashpot"] == 0.0
     assert light.data["snap_work_N_mm"] <= SNAP_WORK_LIMIT
+    assert cls.checks("a", light, CTX) == []
     part = cls.synthesise("a", CTX, 1, {}, HEAVY)
     d = part.data["design"]
+    (landing,) = cls.checks("a", part, CTX)
+    amp = AmpDesign(**d)
+    assert landing.value == landing_speed(amp) / roller_matched_speed(amp) <= MAX_LANDING_RATIO
+    assert landing.passed
+    # a dashpot sized for more than MAX_LANDING_RATIO x the driven speed fails the check
+    loose = cls.synthesise("a", CTX, 1, {"landing_ratio": 2 * MAX_LANDING_RATIO}, HEAVY)
+    (too_fast,) = cls.checks("a", loose, CTX)
+    assert too_fast.value > MAX_LANDING_RATIO and not too_fast.passed
     # the snap work against an independent quadrature of the spring torque from its endpoints
     half = max(d["theta_on"], -d["theta_off"])
     grid = np.linspace(0.0, half, 2001)
@@ -105,12 +119,13 @@ def test_landing_check_flags_an_undamped_heavy_amplifier_and_bounds_the_damped_o
         assert damped <= landing_speed(AmpDesign(**d)) * (1 + 1e-9)
 
 
-def _and_pair():
+def _and_pair(params: dict | None = None):
     """An amplifier on input a driving two ANDs with input b; the ANDs' outputs carry 20 N so
     the amplifier must hold about what the adder's a12 holds (the ANDs need no amplifier: b's
-    actuator is rated 1 kN)."""
+    actuator is rated 1 kN). ``params``: the amplifier's."""
     nl = Netlist(["a", "b"])
-    nl.add_cell(CellInst("amp", "amplifier", "AMPLIFIER", ("a",), ("y",)), pin_names=["A"])
+    nl.add_cell(CellInst("amp", "amplifier", "AMPLIFIER", ("a",), ("y",), params or {}),
+                pin_names=["A"])
     for i in range(2):
         nl.add_cell(CellInst(f"g{i}", "and", "AND", ("y", "b"), (f"z{i}",)),
                     pin_names=["A", "B"])
@@ -119,6 +134,16 @@ def _and_pair():
     opts = CompileOptions(mech=MechOptions(actuator_force=1000.0, output_load=20.0),
                           amplify=False)
     return compile_netlist(spec, nl, opts, library=LIB)
+
+
+def test_an_undamped_heavy_amplifier_fails_the_design_checks():
+    """The landing rule is a design check of the compiled design, not an exception."""
+    from mechc.stdlib.amplifier import SNAP_WORK_LIMIT
+
+    checks = _and_pair({"landing_ratio": 0}).mechanism.checks
+    failed = [c for c in checks if not c.passed]
+    assert [(c.where, "slam" in c.name) for c in failed] == [("amplifier amp", True)]
+    assert failed[0].value > SNAP_WORK_LIMIT == failed[0].limit
 
 
 def test_switching_with_its_loads_held_still_does_not_slam_the_output():

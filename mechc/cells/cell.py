@@ -6,8 +6,9 @@ docs/write-a-cell.md.
 
 Besides its logic type and cost, a cell builds its mechanism (``synthesise``), and the compiler
 evaluates it with the generic closed-form kinematics and pymunk dynamics of
-``mechc.mech`` — a cell with parts those do not cover (cams, rollers, toggles) overrides
-``kinematics`` / ``build_dynamics``.
+``mechc.physics`` — a cell with parts those do not cover (cams, rollers, toggles) overrides
+``kinematics`` / ``build_dynamics``. A cell with design rules of its own returns them as checks
+(``checks``), which the design-check pass adds to the design's.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from mechc.ir.check import Check
 from mechc.ir.mechanism import Demand, Part, SynthContext
 from mechc.physics.closed_form import solve
 
@@ -76,6 +78,13 @@ class Cell:
         going down from y = 0, every signal at half stroke. ``demand`` is the force the output
         must deliver each way; the part's ``data["input_loads"]`` says what each input asks."""
         raise NotImplementedError(f"cell {cls.name} has no mechanism")
+
+    @classmethod
+    def checks(cls, cid: str, part: Part, ctx: SynthContext) -> list[Check]:
+        """The cell's own design rules on its placed instance ``cid`` (numbers in
+        ``part.data``), beyond what the compiler measures on every mechanism; a failed one
+        fails the design like any other check. The default has none."""
+        return []
 
     @classmethod
     def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):

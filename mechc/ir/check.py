@@ -30,5 +30,14 @@ class Check:
                 "passed": self.passed}
 
     def text(self) -> str:
-        return (f"{self.name} at {self.where}: {self.value:.4g}{self.unit} "
-                f"(limit {self.sense} {self.limit:g}{self.unit})")
+        """The check with its place, for a failure list."""
+        # a unit written as a word (N mm) stands apart from its number; ° and x do not
+        u = f" {self.unit}" if self.unit[:1].isalpha() and self.unit != "x" else self.unit
+        return (f"{self.name} at {self.where}: {self.value:.4g}{u} "
+                f"(limit {self.sense} {self.limit:g}{u})")
+
+    def __str__(self) -> str:
+        """The check and its verdict without its place (the threshold toolkit's reports name
+        the generator once, not per check)."""
+        ok = "ok" if self.passed else "FAILED"
+        return f"{self.name} = {self.value:.4g} {self.unit} ({self.sense} {self.limit:g}: {ok})"

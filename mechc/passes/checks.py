@@ -1,17 +1,23 @@
-"""Design checks (DESIGN §7) measured on kinematic samples of a whole mechanism.
+"""The design-check pass (DESIGN §7): every check of a synthesised mechanism is made here.
 
-Each check is a number with a limit, so a failure says by how much: minimum transmission angle
-over every sampled state (rest and along single-input motions), distance from singular (toggle)
-configurations, states the closed forms could not solve (parts that cannot assemble, a pin off
-the end of its slot, a slider jammed between contradictory limits), spring force at its weakest
-against what it must move, and each input actuator's rating against what its net needs.
+Each check is a number with a limit, so a failure says by how much. In the order the design
+lists them: the force checks decided when the mechanism was sized (each input actuator's rating
+against what its net needs, a force budget that would not converge), each placed cell's own
+rules (``Cell.checks``), then what the kinematic samples of the whole mechanism measure: minimum
+transmission angle over every sampled state (rest and along single-input motions), distance from
+singular (toggle) configurations, states the closed forms could not solve (parts that cannot
+assemble, a pin off the end of its slot, a slider jammed between contradictory limits), spring
+force at its weakest against what it must move, and for a sequential design each MEMORY's SET
+and RESET never pressing together.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from mechc.cells.library import Library
 from mechc.ir.check import Check
+from mechc.ir.design import Design
 from mechc.ir.mechanism import GROUND, Mechanism
 from mechc.physics.closed_form import Poses, position
 
@@ -90,6 +96,54 @@ class CheckStats:
             req = self.mech.cells[cid].data["spring_required_N"][sid]
             out.append(Check("spring force margin", sid, f / req, MIN_SPRING_MARGIN, ">=", "x"))
         return out
+
+
+def run_design_checks(design: Design, lib: Library) -> None:
+    """Measure the design checks on the closed-form kinematics (every input state and every
+    single-input change up to 10 inputs) and record them in the mechanism and the stats."""
+    # imported here, not at the top: mechc.proofs.kinematic imports CheckStats from this module
+    from mechc.proofs.kinematic import sweep
+
+    mech = design.mechanism
+    stats = CheckStats(mech)
+    wide = len(design.netlist.inputs) > 10
+    # a budget of cell-states, so a big design is checked on a sample (the kinematic proof,
+    # `mechc simulate --level kinematic`, remains exhaustive up to 10 inputs)
+    budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
+    sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
+    measured = stats.checks()
+    if design.sequential is not None:
+        measured += _memory_checks(design, lib, stats)
+    mech.checks = mech.synthesis_checks() + cell_checks(design, lib) + measured
+    failed = [c for c in mech.checks if not c.passed]
+    mus = [c.value for c in mech.checks if c.name == "transmission angle"]
+    design.stats["design_checks"] = {
+        "passed": not failed, "count": len(mech.checks), "failed": [c.text() for c in failed],
+        "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
+    }
+
+
+def cell_checks(design: Design, lib: Library) -> list[Check]:
+    """Each placed cell's own rules (``Cell.checks``), cells in topological order."""
+    mech = design.mechanism
+    out: list[Check] = []
+    for cid in mech.order:
+        cls = lib[design.netlist.cells[cid].cell]
+        out += cls.checks(cid, mech.cells[cid], mech.ctx)
+    return out
+
+
+def _memory_checks(design: Design, lib: Library, stats: CheckStats) -> list[Check]:
+    """A sequential design is also walked through every specified transition (the kinematic
+    sequential proof): each MEMORY's SET and RESET must never press its lever together."""
+    # imported here, not at the top: mechc.proofs.seq_mechanism imports CheckStats from here
+    from mechc.proofs.seq_mechanism import prove_sequential_kinematic
+
+    r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)
+    per_cell = r["overlaps_by_cell"]
+    mems = [c.id for c in design.netlist.cells.values() if c.type == "MEMORY"]
+    return [Check("SET and RESET apart (transitions where both press)", f"MEMORY {c}",
+                  float(per_cell.get(c, 0)), 0.0, "<=") for c in mems]
 
 
 def kinematic_checks(mech: Mechanism, poses: Poses) -> list[Check]:

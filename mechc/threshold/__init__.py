@@ -13,7 +13,6 @@ from mechc.threshold.functions import (
     truth_table_from_fv,
 )
 from mechc.threshold.generator import (
-    DesignCheck,
     GeneratorDesign,
     KinematicState,
     design_generator,
@@ -29,7 +28,6 @@ from mechc.threshold.weights import (
 )
 
 __all__ = [
-    "DesignCheck",
     "GeneratorDesign",
     "KinematicState",
     "Realisation",

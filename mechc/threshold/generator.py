@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mechc.errors import DesignError
+from mechc.ir.check import Check
 from mechc.threshold.cam import (
     Follower,
     FollowerProgram,
@@ -65,26 +66,6 @@ TOPOLOGY = {
 }
 
 
-@dataclass(frozen=True)
-class DesignCheck:
-    name: str
-    value: float
-    limit: float
-    unit: str
-    kind: str  # "min": value must be >= limit; "max": value must be <= limit
-
-    @property
-    def passed(self) -> bool:
-        if self.kind == "min":
-            return self.value >= self.limit
-        return self.value <= self.limit
-
-    def __str__(self) -> str:
-        rel = ">=" if self.kind == "min" else "<="
-        ok = "ok" if self.passed else "FAILED"
-        return f"{self.name} = {self.value:.4g} {self.unit} ({rel} {self.limit:g}: {ok})"
-
-
 @dataclass
 class KinematicState:
     """Positions (mm) and angles (rad) for N input vectors; ``output`` is 0..1 of the stroke."""
@@ -117,7 +98,7 @@ class GeneratorDesign:
     cam_pitch: np.ndarray | None = None
     cam_range: tuple[float, float] = (0.0, 0.0)  # working cam angles (rad)
     threshold_gaps_deg: tuple[float, ...] = ()
-    checks: list[DesignCheck] = field(default_factory=list)
+    checks: list[Check] = field(default_factory=list)
     hazards: list[tuple[int, int]] = field(default_factory=list)
     planar: PlanarGenerator | None = None  # set when F moves in two dimensions (no hazards)
 
@@ -125,7 +106,7 @@ class GeneratorDesign:
     def ok(self) -> bool:
         return all(c.passed for c in self.checks)
 
-    def check(self, name: str) -> DesignCheck:
+    def check(self, name: str) -> Check:
         return next(c for c in self.checks if c.name == name)
 
     def cam_body_angle(self, phi: np.ndarray) -> np.ndarray:
@@ -233,15 +214,16 @@ def design_generator(f: Sequence[int] | int, stroke_mm: float = 20.0, n: int = 3
         high = phi[sp.lo >= g + 1].min()
         c = DWELL_CLEARANCE * (high - low)
         bands.append((float(low + c), float(high - c)))
+    at = _where(design)
     checks = [
-        DesignCheck("separator transmission angle", an.min_transmission,
-                    mu_min_deg - TRANSMISSION_TOL, "deg", "min"),
-        DesignCheck("loop FJK transmission angle", float(loop.transmission(sp.F).min()),
-                    mu_min_deg, "deg", "min"),
-        DesignCheck("threshold gap", float(np.degrees(room.min())), 0.0, "deg", "min"),
-        DesignCheck("F gap between adjacent levels", an.min_gap * scale, 0.0, "mm", "min"),
-        DesignCheck("separator structural error", float(np.abs(an.structural_error).max()
-                                                        / an.unit), 0.5, "level", "max"),
+        Check("separator transmission angle", at, an.min_transmission,
+              mu_min_deg - TRANSMISSION_TOL, ">=", "deg"),
+        Check("loop FJK transmission angle", at, float(loop.transmission(sp.F).min()),
+              mu_min_deg, ">=", "deg"),
+        Check("threshold gap", at, float(np.degrees(room.min())), 0.0, ">=", "deg"),
+        Check("F gap between adjacent levels", at, an.min_gap * scale, 0.0, ">=", "mm"),
+        Check("separator structural error", at,
+              float(np.abs(an.structural_error).max() / an.unit), 0.5, "<=", "level"),
     ]
     return _finish(design, phi, tuple(bands), r.below == 1, checks, pressure_limit_deg, strict)
 
@@ -272,19 +254,20 @@ def _design_planar(design: GeneratorDesign, pg: PlanarGenerator, mu_min_deg: flo
         gaps.append(float(np.degrees(lo - hi)))
     design.threshold_gaps_deg = tuple(gaps)
     design.hazards = []  # held outputs stay on their dwells: the mechanism has none
+    at = _where(design)
     checks = [
-        DesignCheck("separator transmission angle", ms.min_transmission,
-                    mu_min_deg - TRANSMISSION_TOL, "deg", "min"),
-        DesignCheck("loop FJK transmission angle", float(pg.loop.transmission(F).min()),
-                    mu_min_deg, "deg", "min"),
-        DesignCheck("threshold gap", min(gaps), 0.0, "deg", "min"),
+        Check("separator transmission angle", at, ms.min_transmission,
+              mu_min_deg - TRANSMISSION_TOL, ">=", "deg"),
+        Check("loop FJK transmission angle", at, float(pg.loop.transmission(F).min()),
+              mu_min_deg, ">=", "deg"),
+        Check("threshold gap", at, min(gaps), 0.0, ">=", "deg"),
     ]
     primed_out = (rr[0][2] ^ int(inverted)) == 1
     return _finish(design, phi, tuple(bands), primed_out, checks, pressure_limit_deg, strict)
 
 
 def _finish(design: GeneratorDesign, phi: np.ndarray, bands: tuple[tuple[float, float], ...],
-            primed_out: bool, checks: list[DesignCheck], pressure_limit_deg: float,
+            primed_out: bool, checks: list[Check], pressure_limit_deg: float,
             strict: bool) -> GeneratorDesign:
     """Follower program, follower, closed cam and the remaining checks, from the cam angles
     ``phi`` (rad) F reaches at rest and on every change and the transition bands."""
@@ -315,18 +298,23 @@ def _finish(design: GeneratorDesign, phi: np.ndarray, bands: tuple[tuple[float, 
     design.cam_pitch = pitch * scale
     design.cam_profile = profile(pitch, fol.roller) * scale
 
+    at = _where(design)
     design.checks = checks[:2] + [
-        DesignCheck("cam pressure angle", pa, pressure_limit_deg, "deg", "max")] + checks[2:] + [
-        DesignCheck("pitch curve convex radius / roller radius", convex_min / fol.roller, 1.0,
-                    "", "min"),
-        DesignCheck("shortest loop link / l", min(loop.FJ, loop.JK), 1.0 / 3.0 - 1e-9, "",
-                    "min"),
+        Check("cam pressure angle", at, pa, pressure_limit_deg, "<=", "deg")] + checks[2:] + [
+        Check("pitch curve convex radius / roller radius", at, convex_min / fol.roller, 1.0,
+              ">=", ""),
+        Check("shortest loop link / l", at, min(loop.FJ, loop.JK), 1.0 / 3.0 - 1e-9, ">=", ""),
     ]
     _record_dimensions(design)
     if strict and not design.ok:
         bad = "; ".join(str(c) for c in design.checks if not c.passed)
         raise DesignError(f"threshold generator FV {design.fv}: {bad}")
     return design
+
+
+def _where(design: GeneratorDesign) -> str:
+    """The place every check of a generator names (one generator per function)."""
+    return f"threshold generator FV {design.fv}"
 
 
 def _size_follower(loop: ThresholdLoop, program: FollowerProgram, grid: np.ndarray,
