@@ -20,19 +20,11 @@ from functools import lru_cache
 
 import numpy as np
 
+from mechc.geometry.circles import branch_of, circle_intersection
 from mechc.ir.mechanism import Body, Joint, Part
 from mechc.physics.closed_form import cos_sin, position, solve
 
 GROUND_LEN, CRANK, COUPLER, ROCKER = 40.0, 10.0, 40.0, 30.0  # mm: Grashof crank-rocker
-
-
-def _circle_meet(a, b, ra, rb, upper=True):
-    d = math.dist(a, b)
-    along = (ra * ra - rb * rb + d * d) / (2 * d)
-    h = math.sqrt(ra * ra - along * along)
-    ex, ey = (b[0] - a[0]) / d, (b[1] - a[1]) / d
-    s = 1.0 if upper else -1.0
-    return (a[0] + along * ex - s * h * ey, a[1] + along * ey + s * h * ex)
 
 
 @lru_cache(maxsize=1)
@@ -41,9 +33,10 @@ def mechc_part() -> tuple[Part, tuple[float, float]]:
     a proof builds its parts once and solves them for many states)."""
     o2 = (GROUND_LEN, 0.0)
     a = (0.0, CRANK)
-    b = _circle_meet(o2, a, ROCKER, COUPLER, upper=True)
+    b = circle_intersection(o2, ROCKER, a, COUPLER, 1, "four-bar")
     if b[1] < 0:
-        b = _circle_meet(o2, a, ROCKER, COUPLER, upper=False)
+        b = circle_intersection(o2, ROCKER, a, COUPLER, -1, "four-bar")
+    b = (float(b[0]), float(b[1]))
     crank = Body("crank", "lever", [[(0.0, 0.0), a, (1.0, CRANK)]], 0.01, pivot=(0.0, 0.0))
     rocker = Body("rocker", "lever", [[o2, b, (o2[0] + 1.0, 0.0)]], 0.01, pivot=o2)
     j = Joint("coupler", "rod", "crank", "rocker", pa=a, pb=b, length=COUPLER)
@@ -70,13 +63,17 @@ def pylinkage_linkage(steps_per_turn: int):
     return Linkage([o1, o2, crank, rocker], name="four-bar")
 
 
-def _side() -> float:
+def _side() -> int:
     """Which of the two circle meetings is the design pose's (crank at +90°): +1 for the one
     left of the line from the rocker pivot to the crank pin."""
     part, b = mechc_part()
-    o2 = part.bodies[1].pivot
-    ex, ey = 0.0 - o2[0], CRANK - o2[1]
-    return 1.0 if ex * (b[1] - o2[1]) - ey * (b[0] - o2[0]) > 0 else -1.0
+    return branch_of(part.bodies[1].pivot, (0.0, CRANK), b)
+
+
+# The two floors below write the circle meeting out by hand on purpose instead of calling the
+# geometry kernel (mechc.geometry.circles): they exist only to be timed, as the least work any
+# code could do per position (one division, one square root, no checks, no conversions), and
+# are checked against mechc's result in compare(). No mechc path uses them.
 
 
 def bare_rocker_pins(crank_angles: np.ndarray) -> np.ndarray:

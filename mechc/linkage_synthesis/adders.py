@@ -17,6 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechc.geometry.circles import circle_intersection
+
 # --- the exact adder ---------------------------------------------------------------------------
 
 
@@ -171,18 +173,6 @@ class AdderError:
         return float(np.max(np.abs(self.error[self.ok]))) if self.ok.any() else float("inf")
 
 
-def _circle_point(c1, r1, c2, r2, side):
-    """The intersection x of circles (c1, r1), (c2, r2) with sign Im(conj(c2 - c1) (x - c1)) =
-    side, i.e. on a fixed side of the line c1 -> c2.  Vectorised; NaN where the circles miss."""
-    d = np.abs(c2 - c1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)
-        y = np.sqrt(r1 * r1 - a * a)
-        e1 = (c2 - c1) / d
-        # Im(conj(e1) * (1j e1)) = 1 > 0: +y e2 lies on the positive side
-        return c1 + a * e1 + side * y * 1j * e1
-
-
 def structural_error(stages: Sequence[LeverStage], pins: Sequence, anchor,
                      direction: complex = 1.0) -> AdderError:
     """Structural error of a chain of floating levers against its linear law.
@@ -206,7 +196,9 @@ def structural_error(stages: Sequence[LeverStage], pins: Sequence, anchor,
     ok = np.ones(q.shape, bool)
     for st, pin in zip(stages, pins):
         pin = np.asarray(pin, complex)
-        far = _circle_point(pin, st.lever, q, st.link, st.side)
+        # the far end on the lever's side of pin -> anchor (the kernel's branch +1 is the
+        # positive side Im(conj(q - pin) (far - pin)) > 0); NaN where the circles miss
+        far = circle_intersection(pin, st.lever, q, st.link, st.side, miss="nan")
         ok &= np.isfinite(far)
         fars.append(far)
         with np.errstate(invalid="ignore"):

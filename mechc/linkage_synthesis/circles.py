@@ -1,4 +1,5 @@
-"""Plane circle geometry on complex numbers: the intersections every synthesis method here needs.
+"""Plane circle geometry on complex numbers: the intersections every synthesis method here needs
+(the ordinary circle meeting itself is the geometry kernel's, :mod:`mechc.geometry.circles`).
 
 Points are complex numbers (x + iy).  Two representations are used:
 
@@ -15,6 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechc.geometry.circles import circle_intersection, circle_meeting
+
 
 @dataclass(frozen=True)
 class Circle:
@@ -26,18 +29,18 @@ class Circle:
 
 
 def intersect_circles(c1: complex, r1: float, c2: complex, r2: float) -> list[complex]:
-    """The paper's eqs. 10-14: distance a from centre 1 to the radical line, half-chord y, then
-    the two points C1 + a e1 +- y e2.  Returns 0, 1 (tangent) or 2 points."""
+    """The paper's eqs. 10-14 (distance a from centre 1 to the radical line, half-chord y, then
+    the two points C1 + a e1 +- y e2, e2 = e1 turned a quarter turn), by the geometry kernel.
+    Returns 0, 1 (tangent) or 2 points."""
     d = abs(c2 - c1)
     if d == 0.0 or d > r1 + r2 or d < abs(r1 - r2):
         return []
-    a = (r1 * r1 - r2 * r2 + d * d) / (2.0 * d)  # eq. 10
-    y = np.sqrt(max(r1 * r1 - a * a, 0.0))  # eq. 11
-    e1 = (c2 - c1) / d  # eq. 12
-    e2 = 1j * e1  # eq. 13: e1 turned a quarter turn
-    if y == 0.0:
-        return [c1 + a * e1]
-    return [c1 + a * e1 + y * e2, c1 + a * e1 - y * e2]  # eq. 14
+    # rounding may leave y^2 a hair below 0 at a tangency: clamp, as eq. 11 allows
+    hi, y2 = circle_meeting(complex(c1), r1, complex(c2), r2, 1, miss="clamp")
+    if y2 <= 0.0:
+        return [complex(hi)]
+    lo = circle_intersection(complex(c1), r1, complex(c2), r2, -1, miss="clamp")
+    return [complex(hi), complex(lo)]
 
 
 def circumcircle(z1: complex, z2: complex, z3: complex) -> Circle:

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from mechc.geometry.circles import circle_intersection, circle_meeting
 from mechc.linkage_synthesis.mk_circles import ChainSolution
 
 
@@ -74,13 +75,8 @@ def solve_follower(fb: FourBar, input_angle, sign: float):
     Returns (ka, kb, discriminant); kb is NaN where the loop cannot close."""
     g, i, c, f = fb.lengths
     ka = fb.ga + i * np.exp(1j * np.asarray(input_angle, float))
-    d = np.abs(fb.gb - ka)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        a = (c * c - f * f + d * d) / (2.0 * d)
-        disc = c * c - a * a
-        e1 = (fb.gb - ka) / d
-        kb_pos = ka + a * e1 + np.sqrt(disc) * 1j * e1
-        kb_neg = ka + a * e1 - np.sqrt(disc) * 1j * e1
+    kb_pos, disc = circle_meeting(ka, c, fb.gb, f, 1, miss="nan")
+    kb_neg = circle_intersection(ka, c, fb.gb, f, -1, miss="nan")
     s_pos = loop_signs(ka, kb_pos, fb.gb)
     kb = np.where(s_pos == sign, kb_pos, kb_neg)
     return ka, kb, disc

@@ -78,6 +78,8 @@ def kinematics(design: ThreeBarDesign, a, b) -> ThreeBarState:
     a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
     sep, di, do = design.sep, design.input_link, design.output_link
     tol = 1e-12 * max(di, do, design.stroke) ** 2
+    # equal input links: M is on AB's perpendicular bisector, so this is the midpoint form of
+    # the circle meeting (a = |AB|/2 exactly), not the general kernel's, with a toggle tolerance
     half = 0.5 * np.hypot(b - a, 2.0 * sep)  # half of |AB|
     disc_i = di * di - half * half
     with np.errstate(invalid="ignore"):

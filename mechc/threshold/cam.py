@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechc.geometry.circles import line_angle_deg, polar
+from mechc.geometry.circles import line_angle_deg, polar, quarter_turn
 
 
 def cycloidal(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -98,10 +98,10 @@ class Follower:
         y, dy = program.evaluate(phi)
         H = self.roller_centre(y)
         arm = H - self.pivot
-        rot = np.stack([-arm[..., 1], arm[..., 0]], -1)
+        rot = quarter_turn(arm)
         dpsi = (self.swing if self.primed else -self.swing) * dy
         rel = H - np.asarray(self.K)
-        cam_v = orientation * np.stack([-rel[..., 1], rel[..., 0]], -1)
+        cam_v = orientation * quarter_turn(rel)
         tangent = dpsi[..., None] * rot - cam_v
         return line_angle_deg(tangent, arm)
 
@@ -136,7 +136,7 @@ def profile(pitch: np.ndarray, roller: float) -> np.ndarray:
     """Cam surface: the pitch curve offset inwards by the roller radius (closed, sampled)."""
     d1 = np.roll(pitch, -1, 0) - np.roll(pitch, 1, 0)
     t = d1 / np.hypot(d1[:, 0], d1[:, 1])[:, None]
-    left = np.stack([-t[:, 1], t[:, 0]], -1)
+    left = quarter_turn(t)
     area = np.sum(pitch[:, 0] * np.roll(pitch[:, 1], -1) - np.roll(pitch[:, 0], -1) * pitch[:, 1])
     inward = left if area > 0 else -left
     return pitch + roller * inward

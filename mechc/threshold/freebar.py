@@ -17,7 +17,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
 
-from mechc.geometry.circles import line_angle_deg, polar
+from mechc.geometry.circles import branch_of, circle_meeting, line_angle_deg, polar, quarter_turn
 from mechc.threshold.functions import input_matrix
 from mechc.threshold.linkage import MAX_LINK, MAX_TURN_DEG, MIN_LINK
 from mechc.threshold.planar import separation, wirings
@@ -56,21 +56,6 @@ def _held(h, edges):
             + [(int(h[a]), rows) for a, b, rows in edges if h[a] == h[b]])
 
 
-def _meet(c1, r1, c2, r2, branch):
-    d = c2 - c1
-    dd = np.hypot(d[..., 0], d[..., 1])
-    a = (dd * dd + r1 * r1 - r2 * r2) / (2 * dd)
-    h2 = r1 * r1 - a * a
-    ex = d / dd[..., None]
-    ey = np.stack([-ex[..., 1], ex[..., 0]], -1)
-    return c1 + a[..., None] * ex + (branch * np.sqrt(np.maximum(h2, 0)))[..., None] * ey, h2 > 0
-
-
-def _side(c1, c2, p):
-    d, w = c2 - c1, p - c1
-    return np.where(d[..., 0] * w[..., 1] - d[..., 1] * w[..., 0] > 0, 1.0, -1.0)
-
-
 def free_points(X: np.ndarray, T: np.ndarray, PR: np.ndarray, mu_min_deg: float = 45.0
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """F (C, P, 2), separator transmission (C,) and assembly flags (C,) of candidates X (C, 11);
@@ -82,7 +67,7 @@ def free_points(X: np.ndarray, T: np.ndarray, PR: np.ndarray, mu_min_deg: float 
     d0 = a0 + polar(np.pi / 2 - beta) * ad[:, None]
     e0 = d0 + polar(gam) * de[:, None]
     ub = polar(bg_dir)
-    vb = np.stack([-ub[:, 1], ub[:, 0]], -1)
+    vb = quarter_turn(ub)
     b0 = e0 - be[:, None] * ub - e_left[:, None] * vb
     g0 = b0 + ub
     c0 = g0 - polar(cg_dir) * cg[:, None]
@@ -96,25 +81,27 @@ def free_points(X: np.ndarray, T: np.ndarray, PR: np.ndarray, mu_min_deg: float 
     A = tip(np.broadcast_to(a0, b0.shape), T[None, :, 0], PR[None, :, 0])
     B = tip(b0, T[None, :, 1], PR[None, :, 1])
     C = tip(c0, T[None, :, 2], PR[None, :, 2])
-    G, ok_g = _meet(B, 1.0, C, cg[:, None], _side(b0, c0, g0)[:, None])
+    # joints clamped where the circles miss, so every candidate can still be scored
+    G, h2_g = circle_meeting(B, 1.0, C, cg[:, None], branch_of(b0, c0, g0)[:, None],
+                             miss="clamp")
     v = G - B
-    E = B + be[:, None, None] * v + e_left[:, None, None] * np.stack([-v[..., 1], v[..., 0]], -1)
-    D, ok_d = _meet(A, ad[:, None], E, de[:, None], _side(np.broadcast_to(a0, e0.shape), e0,
-                                                           d0)[:, None])
+    E = B + be[:, None, None] * v + e_left[:, None, None] * quarter_turn(v)
+    D, h2_d = circle_meeting(A, ad[:, None], E, de[:, None], branch_of(a0, e0, d0)[:, None],
+                             miss="clamp")
     w = D - A
-    F = A + (af[:, None, None] * w + f_left[:, None, None]
-             * np.stack([-w[..., 1], w[..., 0]], -1)) / ad[:, None, None]
+    F = A + (af[:, None, None] * w + f_left[:, None, None] * quarter_turn(w)) / ad[:, None, None]
     mu = np.minimum(line_angle_deg(E - D, A - D), line_angle_deg(C - G, B - G)).min(1)
-    return F, mu, ok_g.all(1) & ok_d.all(1)
+    return F, mu, (h2_g > 0).all(1) & (h2_d > 0).all(1)
 
 
 def _cam(F, K, fj, jk, branch):
-    J, ok = _meet(F, fj[:, None], np.broadcast_to(K[:, None, :], F.shape), jk[:, None], branch)
+    J, h2 = circle_meeting(F, fj[:, None], np.broadcast_to(K[:, None, :], F.shape), jk[:, None],
+                           branch, miss="clamp")
     w = J - K[:, None, :]
     ang = np.arctan2(w[..., 1], w[..., 0])
     ref = np.arctan2(np.sin(ang).mean(1), np.cos(ang).mean(1))
     phi = np.degrees((ang - ref[:, None] + np.pi) % (2 * np.pi) - np.pi)
-    return phi, line_angle_deg(F - J, K[:, None, :] - J).min(1), ok.all(1)
+    return phi, line_angle_deg(F - J, K[:, None, :] - J).min(1), (h2 > 0).all(1)
 
 
 def _score(x, h, branch, tips, mu_min):

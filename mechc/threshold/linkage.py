@@ -23,7 +23,12 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
 
-from mechc.geometry.circles import LoopClosureError, circle_intersection, line_angle_deg
+from mechc.geometry.circles import (
+    LoopClosureError,
+    circle_intersection,
+    circle_meeting,
+    line_angle_deg,
+)
 from mechc.threshold.separator import SeparatorAnalysis, analyse, layout
 
 MIN_LINK = 1.0 / 3.0
@@ -114,15 +119,9 @@ def _evaluate(params: np.ndarray, branch: int, sp: SamplePoints, gaps: tuple[int
     fj = params[:, 2:3]
     jk = params[:, 3:4]
     F = sp.F[None, :, :]
-    d_vec = F - K
-    d = np.hypot(d_vec[..., 0], d_vec[..., 1])
-    a = (d * d + jk * jk - fj * fj) / (2 * d)
-    h2 = jk * jk - a * a
+    # from K towards F, so the branch flips
+    J, h2 = circle_meeting(K, jk, F, fj, -branch, miss="clamp")
     closes = np.all(h2 > 0, axis=1)
-    h = np.sqrt(np.maximum(h2, 0))
-    ex = d_vec / d[..., None]
-    ey = np.stack([-ex[..., 1], ex[..., 0]], -1)
-    J = K + a[..., None] * ex - (branch * h)[..., None] * ey  # from K towards F, branch flipped
     v = J - K
     phi_abs = np.arctan2(v[..., 1], v[..., 0])
     phi, _, _ = _orient(phi_abs, sp)

@@ -34,7 +34,7 @@ import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
 
-from mechc.geometry.circles import branch_of, line_angle_deg, polar
+from mechc.geometry.circles import branch_of, circle_meeting, line_angle_deg, polar, quarter_turn
 from mechc.threshold.functions import input_matrix
 from mechc.threshold.linkage import MAX_LINK, MAX_TURN_DEG, MIN_LINK, ThresholdLoop
 from mechc.threshold.separator import Proportions, SeparatorLayout, input_stroke, layout
@@ -141,7 +141,7 @@ def held_sets(h: tuple[int, ...], ms: MoveSamples) -> list[tuple[int, np.ndarray
 def _f_points(ms: MoveSamples, p1: np.ndarray, q: np.ndarray) -> np.ndarray:
     """F for candidates (C,) of p1 and offset q: (C, P, 2)."""
     v = ms.D[None] - ms.A[None]
-    perp = np.stack([-v[..., 1], v[..., 0]], -1)
+    perp = quarter_turn(v)
     return ms.A[None] + p1[:, None, None] * v + q[:, None, None] * perp
 
 
@@ -150,15 +150,8 @@ def cam_angles(F: np.ndarray, K: np.ndarray, fj: np.ndarray, jk: np.ndarray, bra
     """(phi deg about the circular mean, transmission at J deg, closes) for candidates: F (C, P,
     2), K (C, 2), fj and jk (C,). J on the branch of geometry.circle_intersection(F, ., K, .)."""
     K = K[:, None, :]
-    d_vec = F - K
-    d = np.hypot(d_vec[..., 0], d_vec[..., 1])
-    a = (d * d + jk[:, None] ** 2 - fj[:, None] ** 2) / (2 * d)
-    h2 = jk[:, None] ** 2 - a * a
+    J, h2 = circle_meeting(K, jk[:, None], F, fj[:, None], -branch, miss="clamp")
     closes = np.all(h2 > 0, axis=1)
-    h = np.sqrt(np.maximum(h2, 0))
-    ex = d_vec / d[..., None]
-    ey = np.stack([-ex[..., 1], ex[..., 0]], -1)
-    J = K + a[..., None] * ex - (branch * h)[..., None] * ey
     w = J - K
     ang = np.arctan2(w[..., 1], w[..., 0])
     ref = np.arctan2(np.sin(ang).mean(1), np.cos(ang).mean(1))
