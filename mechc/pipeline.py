@@ -19,11 +19,14 @@ from mechc.ir.layout import Layout
 from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
+from mechc.passes.amplify import amplify_nets, nets_short_of_force, snap_outputs
 from mechc.passes.assemble import MechOptions, synthesise_mechanism
 from mechc.passes.checks import run_design_checks
-from mechc.passes.map import MapOptions, map_equations
+from mechc.passes.flowtable import SynthOptions, derive_equations, synthesise_table
+from mechc.passes.map import MapOptions, map_equations, map_sequential
 from mechc.passes.minimise import MinimiseOptions, minimise
 from mechc.passes.place import place
+from mechc.proofs.seq_logic import outputs_needing_snap
 
 
 @dataclass
@@ -77,9 +80,6 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
     inputs + memories (flow-table synthesis when a table is given), mapped with MEMORY cells,
     then place, synthesise, check. ``mechanism=False`` stops after placement (all a logic-level
     proof needs)."""
-    from mechc.passes.flowtable import SynthOptions, derive_equations
-    from mechc.passes.map import map_sequential
-
     opts = opts or CompileOptions()
     lib = library or load_library(opts.cell_dirs)
     seconds = {} if seconds is None else seconds
@@ -103,8 +103,6 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
     if spec.form == "table" and not spec.table.assign and 0 < v <= MAX_POLARITY_SEARCH:
         # which code of a state variable is "on" is free: each choice swaps SET and RESET and
         # the sign of that variable's literals, so it changes inverters, not literals
-        from mechc.passes.flowtable import synthesise_table
-
         def parts(m):
             return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values())
 
@@ -120,9 +118,6 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
         se, mapped = stage("polarity", cheapest, se, mapped)
     nl, amps = mapped.netlist, {}
     if opts.amplify:
-        from mechc.passes.amplify import snap_outputs
-        from mechc.proofs.seq_logic import outputs_needing_snap
-
         snaps = stage("snap", outputs_needing_snap, nl, spec)
         if snaps:
             nl = snap_outputs(nl, lib, sorted(snaps))
@@ -159,8 +154,6 @@ def synthesise_powered(nl: Netlist, lib: Library, opts: CompileOptions,
     MEMORY loop whose demand grows every time round), put those nets' loads behind AMPLIFIERs
     and synthesise again. Returns the (possibly amplified) netlist, its layout and mechanism,
     and net -> reason for every net amplified."""
-    from mechc.passes.amplify import amplify_nets, nets_short_of_force
-
     amps: dict[str, str] = {}
     for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
         if layout is None or attempt:

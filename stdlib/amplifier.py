@@ -45,6 +45,7 @@ from mechc.errors import DesignError
 from mechc.ir.check import Check
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Part, Point, Spring, SynthContext
 from mechc.physics.closed_form import solve
+from mechc.physics.scene import FAR, N
 
 #: A table computed once by ``python benchmarks/amplifier.py`` (pymunk, default SynthContext
 #: and DynSettings: stroke 20 mm, rollers at 60 rad/s) and re-measured by
@@ -327,8 +328,6 @@ def _add_wedge_clutches(scene, part: Part, t_id: str) -> list[_Clutch]:
     omega = d["speed"] * d["r_r"] / d["rc"]
     if omega <= 0.0:  # rollers at rest, or turning so that they draw F out: no wedge closes
         return []
-    from mechc.physics.scene import N
-
     toggle = scene.bodies[t_id]
     rollers = [b.id for b in part.bodies if b.role == "friction roller"]
     powered = [b.id for b in part.bodies if b.role == "powered roller"]
@@ -498,8 +497,6 @@ class Amplifier(Cell):
         _add_wedge_clutches(scene, part, toggle)
         c = part.data["design"].get("dashpot", 0.0)
         if c > 0.0:
-            from mechc.physics.scene import FAR, N
-
             out = next(b.id for b in part.bodies if b.role == "AMPLIFIER output")
             (rx, ry), (ax, ay) = scene.ref[out], scene.axis[out]
             body = scene.bodies[out]

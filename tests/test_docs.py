@@ -26,3 +26,21 @@ def test_documented_cell_compiles_and_proves(cli, tmp_path):
     for level in ("kinematic", "dynamic"):
         rc, out, _ = cli("simulate", design, "--cells", cells, "--level", level, "--cases", "4")
         assert rc == 0, out
+
+
+ARCH = DOC.parent / "architecture.md"
+
+
+def test_architecture_names_only_real_paths_and_every_package():
+    """docs/architecture.md is the map of the tree: every module it names exists, and every
+    package of mechc appears in it (so a new package cannot go undocumented)."""
+    text = ARCH.read_text()
+    root = DOC.parents[1]
+    named = set(re.findall(r"`((?:mechc|stdlib)/[\w/]+(?:\.py)?/?)`", text))
+    assert named, "the architecture doc names no paths"
+    missing = [p for p in named if not (root / p).exists()]
+    assert not missing, f"architecture.md names paths that do not exist: {missing}"
+    packages = {p.parent.relative_to(root).as_posix() for p in (root / "mechc").glob(
+        "*/__init__.py")}
+    undocumented = [p for p in sorted(packages) if f"`{p}/`" not in text]
+    assert not undocumented, f"packages missing from architecture.md: {undocumented}"

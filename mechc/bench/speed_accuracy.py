@@ -670,7 +670,7 @@ def stability_chart(b: Bench, study: dict, path: Path) -> None:
     sel = [(x, y) for x, y in zip(mg, er) if x and np.isfinite(y) and x > 0]
     if sel:
         ax.loglog(*zip(*sel), "o-")
-    from mechc.passes.checks import MIN_SINGULAR_MARGIN_DEG
+    from mechc.physics.measures import MIN_SINGULAR_MARGIN_DEG
 
     ax.axvline(MIN_SINGULAR_MARGIN_DEG, color="r", ls="--", lw=1)
     ax.text(MIN_SINGULAR_MARGIN_DEG, 0.5, " design check:\n reported below", color="r",

@@ -10,6 +10,9 @@ from pathlib import Path
 
 import matplotlib
 
+from mechc.linkage_synthesis.mk_circles import PIVOT_NAMES, pole
+from mechc.linkage_synthesis.three_bar import STATES, kinematics
+
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
@@ -50,8 +53,6 @@ def _circle(ax, c, colour, ls="-", lw=1.0, label=None):
 
 def plot_chain(result, path: str, title: str = "") -> None:
     """Circles of every circle position, poles (dyads), and each solution chain in position 1."""
-    from mechc.linkage_synthesis.mk_circles import PIVOT_NAMES, pole
-
     fig, ax = plt.subplots(figsize=(7, 6))
     pr = result.problem
     ax.plot(pr.points.real, pr.points.imag, "kx", ms=8, label="precision points")
@@ -98,8 +99,6 @@ def plot_three_bar(answer, path: str, chart: list[dict] | None = None,
                    request: tuple[float, float] | None = None) -> None:
     """Left: the design in its four states.  Right: healthy output positions over separation
     (the chart to pick a healthy design from), with the request marked."""
-    from mechc.linkage_synthesis.three_bar import STATES, kinematics
-
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 5))
     d = answer.design
     if d is not None:

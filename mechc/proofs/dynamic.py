@@ -26,7 +26,7 @@ from mechc.errors import UsageError
 from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
-from mechc.passes.checks import CheckStats
+from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, Scene
 from mechc.proofs.cases import gray_tour, random_walk
 from mechc.proofs.kinematic import sweep

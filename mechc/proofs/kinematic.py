@@ -19,9 +19,9 @@ from mechc.errors import UsageError
 from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
-from mechc.passes.checks import CheckStats
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import evaluate, output_signals
+from mechc.physics.measures import CheckStats
 from mechc.proofs.cases import bits, single_changes
 from mechc.proofs.logic import check_interface
 

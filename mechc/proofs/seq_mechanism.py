@@ -21,9 +21,9 @@ import numpy as np
 from mechc.cells.library import Library
 from mechc.errors import UsageError
 from mechc.ir.design import Design
-from mechc.passes.checks import CheckStats
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
+from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, Scene
 from mechc.proofs.seq_logic import expected_after, transition_tour
 

@@ -27,6 +27,7 @@ point of BG, searched by :mod:`mechc.threshold.freebar`) serves it (docs/thresho
 from __future__ import annotations
 
 import itertools
+import time
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -35,9 +36,10 @@ from scipy.optimize import minimize
 from scipy.stats import qmc
 
 from mechc.geometry.circles import branch_of, circle_meeting, line_angle_deg, polar, quarter_turn
-from mechc.threshold.functions import input_matrix
+from mechc.threshold.functions import input_matrix, npn_canonical, truth_table_from_fv
 from mechc.threshold.linkage import MAX_LINK, MAX_TURN_DEG, MIN_LINK, ThresholdLoop
 from mechc.threshold.separator import Proportions, SeparatorLayout, input_stroke, layout
+from mechc.threshold.weights import realise, static_hazards
 
 P1_MAX = 4.0 / 3.0  # F at most l/3 beyond D, as for threshold generators
 P2_RANGE = (0.2, 1.5)  # E at most l/2 beyond G
@@ -385,11 +387,6 @@ def _build(h: tuple[int, ...], lay: SeparatorLayout, loop: tuple[float, ...], br
 def main() -> None:
     """Search every NPN class whose threshold realisations all have static hazards and print
     the entries of :data:`PLANAR_DESIGNS` (``python -m mechc.threshold.planar``)."""
-    import time
-
-    from mechc.threshold.functions import npn_canonical, truth_table_from_fv
-    from mechc.threshold.weights import realise, static_hazards
-
     classes = sorted({npn_canonical(truth_table_from_fv(fv)) for fv in range(256)
                       if static_hazards(realise(fv).weights, truth_table_from_fv(fv))})
     for c in classes:

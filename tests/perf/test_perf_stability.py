@@ -17,8 +17,8 @@ from scipy.optimize import brentq
 from mechc.bench import stability
 from mechc.cells.library import load_library
 from mechc.frontends import load_spec
-from mechc.passes.checks import MIN_SINGULAR_MARGIN_DEG
 from mechc.physics.closed_form import solve
+from mechc.physics.measures import MIN_SINGULAR_MARGIN_DEG
 from mechc.physics.scene import DynSettings
 from mechc.pipeline import compile_spec
 from mechc.proofs.dynamic import prove_dynamic
