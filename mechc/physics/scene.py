@@ -38,7 +38,9 @@ from mechc.parts.contact import FAR
 from mechc.physics.closed_form import Poses
 from mechc.physics.evaluate import CellModels, output_signals, settle
 
+# FAR and N are part of this module's interface (cells' build_dynamics use them)
 __all__ = ["FAR", "MOVE_SAMPLES", "N", "DynSettings", "MoveResult", "Scene", "min_jerk"]
+
 MOVE_SAMPLES = 41  # closed-form samples along an input move (boundary drive and reference)
 
 
