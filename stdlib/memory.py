@@ -21,7 +21,8 @@ import numpy as np
 from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Spring
-from mechc.physics.closed_form import KinematicsError, Poses, _slider_from_rod
+from mechc.parts.rod import slider_from_rod
+from mechc.physics.closed_form import KinematicsError, Poses
 
 PUSH = 0.6  # contact travel of an input arm from upright to a stop, in strokes
 CLEAR = 0.1  # gap (strokes) between an input face at off and the lever at its far stop
@@ -174,7 +175,7 @@ class Memory(Cell):
         for bid in (s_body, r_body, lever.id):
             poses.bad[bid] = np.array(jam)
         rod = next(j for j in part.joints if j.kind == "rod")
-        _slider_from_rod(rod, bodies[q_body], lever, poses, size)
+        slider_from_rod(rod, bodies[q_body], lever, poses, size)
         poses.mark(q_body, jam)
         poses.state[lever.id.rsplit(".", 1)[0]] = new
         return poses

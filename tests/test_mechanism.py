@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from mechc.backends.design_json import design_from_json, design_to_json
+from mechc.backends.design_json import design_from_json, design_to_json, schema
 from mechc.cells.library import load_library
 from mechc.frontends import load_spec
 from mechc.frontends.boolfile import parse_bool
 from mechc.ir.mechanism import Demand, SynthContext
+from mechc.parts import BODY_KINDS, JOINT_KINDS
 from mechc.physics.closed_form import position, solve
 from mechc.pipeline import compile_spec
 from mechc.proofs.dynamic import prove_dynamic
@@ -269,3 +270,24 @@ def test_overloaded_actuator_stalls_and_is_reported():
     r = prove_dynamic(d, d.spec, LIB, extra=0)
     assert not r["passed"]
     assert r["failure_kinds"].get("stall") or r["failure_kinds"].get("rest")
+
+
+def test_every_part_kind_a_design_may_hold_has_a_class():
+    """The part-kind registry and the JSON schema name the same body and joint kinds, so no
+    kind can be written that the solver, the scene or the drawing cannot dispatch."""
+    enums: list[set[str]] = []
+
+    def walk(node):
+        if isinstance(node, dict):
+            kind = node.get("properties", {}).get("kind", {})
+            if isinstance(kind, dict) and "enum" in kind:
+                enums.append(set(kind["enum"]))
+            for v in node.values():
+                walk(v)
+        elif isinstance(node, list):
+            for v in node:
+                walk(v)
+
+    walk(schema())
+    assert set(BODY_KINDS) in enums and set(JOINT_KINDS) in enums
+    assert all(cls.name == k for k, cls in {**BODY_KINDS, **JOINT_KINDS}.items())

@@ -4,9 +4,11 @@ builds it.
 Every body is drawn at the pose the kinematic solver gives for that state (not at the design
 pose), so two drawings of the same design in two states show what moves and by how much. Ground
 (pivots, spring anchors, stops) is hatched; grooves are slots with their pin; rods are thin lines
-between pin circles. Coordinates are world millimetres times ``scale``, y flipped (SVG y grows
-downwards). Symbols too small to see at the chosen scale (pins, pivots, hatches) get a minimum
-size in pixels; outlines never do, so the drawing stays true to scale.
+between pin circles. Each part kind says which of these shapes it shows (``mechc.parts``); this
+module says how a shape looks and in which order shapes are painted. Coordinates are world
+millimetres times ``scale``, y flipped (SVG y grows downwards). Symbols too small to see at the
+chosen scale (pins, pivots, hatches) get a minimum size in pixels; outlines never do, so the
+drawing stays true to scale.
 """
 
 from __future__ import annotations
@@ -18,8 +20,13 @@ from xml.sax.saxutils import escape
 
 import numpy as np
 
+from mechc.cells.library import load_library
 from mechc.errors import DesignError, UsageError
 from mechc.ir.mechanism import GROUND, Body, Point
+from mechc.parts import body_kind, joint_kind, position
+from mechc.parts.base import Shape, direction
+from mechc.physics.closed_form import KinematicsError
+from mechc.physics.evaluate import evaluate, signal_of
 
 SCALE_BAR_MM = 50.0
 
@@ -92,7 +99,7 @@ class _Mover:
         self.bodies, self.poses = bodies, poses
         self.unsolved: set[str] = set()
         for bid, b in bodies.items():
-            val = (poses.u if b.kind == "slider" else poses.theta).get(bid)
+            val = getattr(poses, body_kind(b.kind).coordinate).get(bid)
             bad = poses.bad.get(bid)
             if val is None or not np.isfinite(val[0]) or (bad is not None and bool(bad[0])):
                 self.unsolved.add(bid)
@@ -101,8 +108,6 @@ class _Mover:
         xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
         if bid == GROUND or bid in self.unsolved:
             return xs, ys
-        from mechc.physics.closed_form import position
-
         x, y = position(self.bodies[bid], self.poses, (xs, ys))
         return np.broadcast_to(x, xs.shape), np.broadcast_to(y, ys.shape)
 
@@ -110,12 +115,11 @@ class _Mover:
         x, y = self.move(bid, [p[0]], [p[1]])
         return float(x[0]), float(y[0])
 
+    def layer(self, bid: str) -> int:
+        return 0 if bid == GROUND else self.bodies[bid].layer
+
 
 def _pose(design, state: dict[str, int], library=None):
-    from mechc.cells.library import load_library
-    from mechc.physics.closed_form import KinematicsError
-    from mechc.physics.evaluate import evaluate, signal_of
-
     mech = design.mechanism
     types = {c.id: c.cell for c in design.netlist.cells.values()}
     values = {n: np.array([float(state[n])]) for n in design.netlist.inputs}
@@ -133,16 +137,6 @@ def _pose(design, state: dict[str, int], library=None):
 
 
 # ---- the picture --------------------------------------------------------------------------------
-
-@dataclass
-class _Shape:
-    kind: str  # body | slot | pin | pivot | spring | stop | rod
-    pts: list[Point]
-    cls: str = ""
-    ref: str = ""  # body id (for bodies)
-    layer: int = 0
-    ground: Point | None = None  # hatch side (unit vector into the ground)
-
 
 @dataclass
 class _Label:
@@ -206,14 +200,9 @@ def _cell_bounds(part, conn: dict[str, set[int]]) -> tuple[float, float, float, 
     return min(xs), min(ys), max(xs), max(ys)
 
 
-def _unit(v) -> Point:
-    n = math.hypot(v[0], v[1])
-    return (v[0] / n, v[1] / n) if n > 0 else (1.0, 0.0)
-
-
 def _shapes(mech, mover: _Mover, conn: dict[str, set[int]]):
     """Every part as shapes in world mm at the state's pose; cell boxes (design pose)."""
-    shapes: list[_Shape] = []
+    shapes: list[Shape] = []
     boxes: dict[str, tuple[float, float, float, float]] = {}
     owners: list[tuple[str, object]] = [(f"in:{k}", p) for k, p in mech.inputs.items()]
     owners += [(c, mech.cells[c]) for c in mech.order]
@@ -231,44 +220,30 @@ def _shapes(mech, mover: _Mover, conn: dict[str, set[int]]):
             else:
                 cls = f"L{max(0, min(b.layer, len(_LAYERS) - 1))}"
             for poly in own:
-                shapes.append(_Shape("body", poly, cls, b.id, b.layer))
+                shapes.append(Shape("body", poly, cls, b.id, b.layer))
             for poly in extra:  # fan-out bars: drawn over every layer, in connector colours
-                shapes.append(_Shape("body", poly, "bad" if cls == "bad" else "cn", b.id,
-                                     _TOP_LAYER))
-            if b.kind == "lever" and b.pivot is not None:
-                shapes.append(_Shape("pivot", [b.pivot], ref=b.id, ground=(0.0, -1.0)))
+                shapes.append(Shape("body", poly, "bad" if cls == "bad" else "cn", b.id,
+                                    _TOP_LAYER))
+            shapes += body_kind(b.kind).symbols(b)
         for j in part.joints:
-            if j.kind == "groove":
-                p0, p1 = mover.pt(j.a, j.p0), mover.pt(j.a, j.p1)
-                shapes.append(_Shape("slot", [p0, p1], ref=j.id, layer=_layer(mover, j.a)))
-                shapes.append(_Shape("pin", [mover.pt(j.b, j.q)], ref=j.id))
-            elif j.kind == "contact" and GROUND in (j.a, j.b):
-                gp = j.pa if j.a == GROUND else j.pb
-                n = _unit(j.normal)
-                into = (-n[0], -n[1]) if j.a == GROUND else n  # the ground lies this way
-                shapes.append(_Shape("stop", [gp], ground=into))
-            elif j.kind == "rod":
-                pa, pb = mover.pt(j.a, j.pa), mover.pt(j.b, j.pb)
-                shapes.append(_Shape("rod", [pa, pb], ref=j.id))
+            shapes += joint_kind(j.kind).shapes(j, mover)
         for s in part.springs:
             pa, pb = mover.pt(s.a, s.pa), mover.pt(s.b, s.pb)
             g = (s.a == GROUND, s.b == GROUND)
-            shapes.append(_Shape("spring", [pa, pb], ground=None))
+            shapes.append(Shape("spring", [pa, pb], ground=None))
             for is_ground, p, q in ((g[0], pa, pb), (g[1], pb, pa)):
                 if is_ground:
-                    shapes.append(_Shape("anchor", [p], ground=_unit((p[0] - q[0],
-                                                                       p[1] - q[1]))))
+                    shapes.append(Shape("anchor", [p], ground=direction((p[0] - q[0],
+                                                                         p[1] - q[1]))))
         if not owner.startswith("in:"):
             # the box stays at the design pose in every state: a fixed frame that shows how far
             # the parts have moved (by up to half a stroke)
             x0, y0, x1, y1 = _cell_bounds(part, conn)
             pad = 0.3 * mech.ctx.bar
             boxes[owner] = (x0 - pad, y0 - pad, x1 + pad, y1 + pad)
-    for part in mech.nets.values():
+    for part in mech.nets.values():  # the nets' rods, over every cell
         for j in part.joints:
-            if j.kind == "rod":
-                shapes.append(_Shape("rod", [mover.pt(j.a, j.pa), mover.pt(j.b, j.pb)],
-                                     ref=j.id))
+            shapes += joint_kind(j.kind).shapes(j, mover)
     return shapes, boxes
 
 
@@ -299,8 +274,8 @@ def _labels(design, mover: _Mover, outs: dict[str, float], state: dict[str, int]
         x, _ = mover.pt(b.id, tip)
         # and clear of the fixed ends of its springs and stops on that row
         part = mech.owner_part(owner)
-        fixed = [p[0] for j in part.joints if GROUND in (j.a, j.b) and j.kind == "contact"
-                 for p in (j.pa if j.a == GROUND else j.pb,) if abs(p[1] - mid[1]) < w]
+        stops = [joint_kind(j.kind).ground_point(j) for j in part.joints]
+        fixed = [p[0] for p in stops if p is not None and abs(p[1] - mid[1]) < w]
         fixed += [p[0] for sp in part.springs for who, p in ((sp.a, sp.pa), (sp.b, sp.pb))
                   if who == GROUND and abs(p[1] - mid[1]) < w]
         if fixed and max(fixed) > tip[0]:
@@ -348,13 +323,7 @@ def _reach(mech) -> list[Point]:
     out: list[Point] = []
     for part in mech.all_parts():
         for b in part.bodies:
-            pts = np.array([p for poly in b.outline for p in poly], dtype=float)
-            if b.kind == "lever" and b.pivot is not None:
-                r = float(np.hypot(pts[:, 0] - b.pivot[0], pts[:, 1] - b.pivot[1]).max())
-                out += [(b.pivot[0] - r, b.pivot[1] - r), (b.pivot[0] + r, b.pivot[1] + r)]
-            elif b.axis is not None:
-                ax = np.array(b.axis, dtype=float) * S
-                out += [tuple(p) for p in np.vstack([pts - ax, pts + ax]).tolist()]
+            out += body_kind(b.kind).reach(b, S)
         for j in part.joints:
             if j.a == GROUND and j.pa is not None:
                 out.append(j.pa)
@@ -364,10 +333,6 @@ def _reach(mech) -> list[Point]:
             out += [s.pa] if s.a == GROUND else []
             out += [s.pb] if s.b == GROUND else []
     return out
-
-
-def _layer(mover: _Mover, bid: str) -> int:
-    return 0 if bid == GROUND else mover.bodies[bid].layer
 
 
 def _attr(text: str) -> str:
@@ -398,9 +363,7 @@ def _place_labels(labs: list[_Label], fs: float, px, py) -> list[tuple[float, ..
 
 def _sweep(b: Body, stroke: float) -> Point:
     """How far a point of ``b`` may move from its design pose (half a stroke on a slider)."""
-    if b.kind == "slider" and b.axis is not None:
-        return (abs(b.axis[0]) * stroke / 2, abs(b.axis[1]) * stroke / 2)
-    return (0.0, 0.0)
+    return body_kind(b.kind).sweep(b, stroke)
 
 
 def _text_w(text: str, size: float, bold: bool = False) -> float:
@@ -510,7 +473,7 @@ class _Frame:
         return "M" + "L".join(f"{self.X(x):.1f},{self.Y(y):.1f}" for x, y in poly) + "Z"
 
 
-def _svg_bodies(shapes: list[_Shape], f: _Frame, pin_r: float) -> list[str]:
+def _svg_bodies(shapes: list[Shape], f: _Frame, pin_r: float) -> list[str]:
     """Bodies grouped by body, lower layers first; each layer's slots right after it."""
     out: list[str] = []
     bodies: dict[tuple[int, str, str], list] = {}
@@ -538,7 +501,7 @@ def _svg_bodies(shapes: list[_Shape], f: _Frame, pin_r: float) -> list[str]:
     return out
 
 
-def _svg_mechanics(shapes: list[_Shape], f: _Frame, sym: float, pin_r: float) -> list[str]:
+def _svg_mechanics(shapes: list[Shape], f: _Frame, sym: float, pin_r: float) -> list[str]:
     """Springs, rods, pins, pivots and ground marks, over the bodies."""
     out = [f'<path class="sp" d="{_zigzag(s.pts, f.X, f.Y, sym)}"/>' for s in shapes
            if s.kind == "spring"]

@@ -11,7 +11,8 @@ from typing import Any, Protocol
 import numpy as np
 
 from mechc.ir.mechanism import Body, Mechanism, Terminal
-from mechc.physics.closed_form import Poses, _slider_from_rod, position
+from mechc.parts.rod import slider_from_rod
+from mechc.physics.closed_form import Poses, position
 
 
 class CellModels(Protocol):
@@ -64,7 +65,7 @@ def evaluate(mech: Mechanism, lib: CellModels, cell_types: dict[str, str],
         for t in part.terminals.values():
             for j in rods_to.get(t.body, []):
                 if t.body not in fixed:
-                    _slider_from_rod(j, bodies[t.body], bodies[j.a], poses, size)
+                    slider_from_rod(j, bodies[t.body], bodies[j.a], poses, size)
                     fixed[t.body] = poses.u[t.body]
         cls = lib[cell_types[cid]]
         sub = cls.kinematics(part, fixed, size, prior.get(cid))

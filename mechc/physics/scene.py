@@ -1,7 +1,8 @@
 """Dynamic model: a pymunk scene built from a mechanism's geometry, and input moves run on it.
 
 Units inside pymunk: mm, kg, s (so a force of 1 N is 1000). Every body of the chosen cells
-becomes a pymunk body placed at its kinematic pose for the starting input state:
+becomes a pymunk body placed at its kinematic pose for the starting input state; each part
+kind builds its own (``mechc.parts``):
 
 - slider: rotation locked (infinite moment), a groove joint to the ground along its axis, and
   Coulomb guide friction (a ground pivot with no position correction whose force is capped);
@@ -31,11 +32,15 @@ import pymunk
 import pymunk.batch as pb
 
 from mechc.ir.mechanism import GROUND, Body, Mechanism
+from mechc.parts import body_kind, joint_kind
+from mechc.parts.base import N
+from mechc.parts.contact import FAR
 from mechc.physics.closed_form import Poses
-from mechc.physics.evaluate import CellModels, settle
+from mechc.physics.evaluate import CellModels, output_signals, settle
 
-N = 1000.0  # newtons -> pymunk force units (kg mm / s^2)
-FAR = 1000.0  # mm: how far behind a contact face its slide-joint anchor sits
+# FAR and N are part of this module's interface (cells' build_dynamics use them)
+__all__ = ["FAR", "MOVE_SAMPLES", "N", "DynSettings", "MoveResult", "Scene", "min_jerk"]
+
 MOVE_SAMPLES = 41  # closed-form samples along an input move (boundary drive and reference)
 
 
@@ -171,129 +176,47 @@ class Scene:
         return (p[0] - rx, p[1] - ry)
 
     def _add_body(self, b: Body, poses: Poses, kinematic: bool) -> None:
-        if b.kind == "slider":
-            pts = [p for poly in b.outline for p in poly]
-            ref = (sum(p[0] for p in pts) / len(pts), sum(p[1] for p in pts) / len(pts))
-        else:
-            ref = b.pivot
-        if kinematic or b.kind == "rotor":
+        kind = body_kind(b.kind)
+        ref = kind.scene_ref(b)
+        if kinematic:
             body = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-        elif b.kind == "slider":
-            body = pymunk.Body(b.mass, math.inf)
         else:
-            r2 = max(sum((p[0] - ref[0]) ** 2 + (p[1] - ref[1]) ** 2 for poly in b.outline
-                         for p in poly) / max(1, sum(len(pl) for pl in b.outline)), 1.0)
-            body = pymunk.Body(b.mass, b.mass * r2)
+            body = kind.pymunk_body(b, ref)
         self.ref[b.id] = ref
         self.kind[b.id] = b.kind
-        if b.kind == "slider":
-            u = float(poses.u[b.id][0])
-            self.axis[b.id] = b.axis
-            body.position = (ref[0] + u * b.axis[0], ref[1] + u * b.axis[1])
-        elif b.kind == "link":
-            tx, ty = poses.xy[b.id]
-            body.position = (ref[0] + float(np.ravel(tx)[0]), ref[1] + float(np.ravel(ty)[0]))
-            body.angle = float(poses.theta[b.id][0])
-        elif b.kind == "rotor":  # powered: turns at its set speed whatever loads it
-            body.position = ref
-            body.angular_velocity = float(b.speed or 0.0)
-        else:
-            body.position = ref
-            body.angle = float(poses.theta[b.id][0])
+        kind.place(self, b, body, ref, poses)
         self.space.add(body)
         self.bodies[b.id] = body
         if kinematic:
             self.boundary.add(b.id)
             return
-        if b.kind in ("link", "rotor"):  # free in the plane / driven by its motor
-            return
-        i = len(self.bodies) - 1
-        if b.kind == "slider":
-            L = 2.0 * self.mech.ctx.stroke
-            a0 = (ref[0] - L * b.axis[0], ref[1] - L * b.axis[1])
-            a1 = (ref[0] + L * b.axis[0], ref[1] + L * b.axis[1])
-            self.space.add(pymunk.GrooveJoint(self.space.static_body, body, a0, a1, (0, 0)))
-            self.joints.append(_J(f"{b.id}.guide", "groove", -1, a0, i, (0, 0), (a1,)))
-            fr = pymunk.PivotJoint(self.space.static_body, body, (0, 0), (0, 0))
-            fr.max_bias = 0
-            fr.max_force = self.mech.ctx.friction * N
-            self.space.add(fr)
-        else:
-            self.space.add(pymunk.PivotJoint(self.space.static_body, body, ref, (0, 0)))
-            self.joints.append(_J(f"{b.id}.pivot", "pivot", -1, ref, i, (0, 0)))
+        kind.hold(self, b, body, ref)
 
-    def _b(self, bid: str):
+    # what a part kind asks of the scene while it builds its bodies and joints
+    def body_of(self, bid: str) -> pymunk.Body:
+        """The pymunk body of ``bid`` (the space's static body for the ground)."""
         return self.space.static_body if bid == GROUND else self.bodies[bid]
 
-    def _idx(self, bid: str) -> int:
+    def order_of(self, bid: str) -> int:
+        """Index of ``bid`` among the scene's bodies (-1: the ground)."""
         return -1 if bid == GROUND else list(self.bodies).index(bid)
 
-    def _anchor(self, bid: str, p) -> tuple[float, float]:
+    def anchor(self, bid: str, p) -> tuple[float, float]:
+        """World point ``p`` in the frame of ``bid``'s pymunk body."""
         return tuple(p) if bid == GROUND else self._local(bid, p)
 
-    def _add_joint(self, j) -> None:
-        if j.kind == "groove":
-            c = pymunk.GrooveJoint(self._b(j.a), self._b(j.b), self._anchor(j.a, j.p0),
-                                   self._anchor(j.a, j.p1), self._anchor(j.b, j.q))
-            self.joints.append(_J(j.id, "groove", self._idx(j.a), self._anchor(j.a, j.p0),
-                                  self._idx(j.b), self._anchor(j.b, j.q),
-                                  (self._anchor(j.a, j.p1),)))
-        elif j.kind == "rod":
-            c = pymunk.PinJoint(self._b(j.a), self._b(j.b), self._anchor(j.a, j.pa),
-                                self._anchor(j.b, j.pb))
-            c.distance = j.length
-            self.joints.append(_J(j.id, "rod", self._idx(j.a), self._anchor(j.a, j.pa),
-                                  self._idx(j.b), self._anchor(j.b, j.pb), (j.length,)))
-        elif j.kind == "contact":
-            far = (j.pa[0] - FAR * j.normal[0], j.pa[1] - FAR * j.normal[1])
-            c = pymunk.SlideJoint(self._b(j.a), self._b(j.b), self._anchor(j.a, far),
-                                  self._anchor(j.b, j.pb), FAR, FAR + 100 * self.mech.ctx.stroke)
-            self.joints.append(_J(j.id, "contact", self._idx(j.a), self._anchor(j.a, far),
-                                  self._idx(j.b), self._anchor(j.b, j.pb), (FAR,)))
-        elif j.kind == "pin":
-            c = pymunk.PivotJoint(self._b(j.a), self._b(j.b), self._anchor(j.a, j.pa),
-                                  self._anchor(j.b, j.pa))
-            self.joints.append(_J(j.id, "pivot", self._idx(j.a), self._anchor(j.a, j.pa),
-                                  self._idx(j.b), self._anchor(j.b, j.pa)))
-        elif j.kind == "touch":
-            self._add_touch(j)
-            return
-        else:
-            raise ValueError(f"unknown joint kind {j.kind}")
-        self.space.add(c)
+    def measure(self, jid: str, kind: str, ia: int, la: tuple, ib: int, lb: tuple,
+                extra: tuple = ()) -> None:
+        """Measure a constraint's stretch after every step (``kind``: pivot, groove, rod or
+        contact; anchors in their bodies' frames, -1 the ground)."""
+        self.joints.append(_J(jid, kind, ia, la, ib, lb, extra))
 
-    def _add_touch(self, j) -> None:
-        """Shapes that collide only with each other (a cam and its roller, a friction roller and
-        the faces it drives); their overrun is measured like a contact's."""
-        bit = 1 << (len(self.touches) % 31)
-        filt = pymunk.ShapeFilter(group=0, categories=bit, mask=bit)
-        a, b = self._b(j.a), self._b(j.b)
-        mu = 0.0 if j.friction is None else j.friction
-        shapes: list[pymunk.Shape] = []
-        if j.profile:
-            pts = [self._anchor(j.a, p) for p in j.profile]
-            shapes += [pymunk.Segment(a, p, q, 0.0) for p, q in zip(pts, pts[1:])]
-        else:
-            shapes.append(pymunk.Circle(a, j.radius_a, self._anchor(j.a, j.pa)))
-        roller = pymunk.Circle(b, j.length, self._anchor(j.b, j.q))
-        shapes.append(roller)
-        for sh in shapes:
-            sh.filter = filt
-            sh.friction = mu  # pymunk multiplies the two shapes' values: the roller's is 1
-            sh.elasticity = 0.0
-        roller.friction = 1.0
-        self.space.add(*shapes)
-        self.touches.append((j, shapes))
-        if j.profile:  # the segments in the profile body's frame, for the overrun measure
-            a = np.array([[sh.a.x, sh.a.y] for sh in shapes[:-1]])
-            b = np.array([[sh.b.x, sh.b.y] for sh in shapes[:-1]])
-            self.profiles.append((a, b - a))
-        else:
-            self.profiles.append(None)
+    def _add_joint(self, j) -> None:
+        joint_kind(j.kind).add_to_scene(self, j)
 
     def _add_spring(self, s) -> None:
-        c = pymunk.DampedSpring(self._b(s.a), self._b(s.b), self._anchor(s.a, s.pa),
-                                self._anchor(s.b, s.pb), s.rest, s.rate * N, s.damping * N)
+        c = pymunk.DampedSpring(self.body_of(s.a), self.body_of(s.b), self.anchor(s.a, s.pa),
+                                self.anchor(s.b, s.pb), s.rest, s.rate * N, s.damping * N)
         self.space.add(c)
 
     # ---- measuring --------------------------------------------------------------------------
@@ -410,14 +333,7 @@ class Scene:
 
     def pose_of(self, bid: str, pos, ang) -> Poses:
         """The scene's pose of one body in the closed form's terms (for signals)."""
-        i = self._pos[bid]
-        rx, ry = self.ref[bid]
-        if self.kind[bid] == "slider":
-            return Poses(u={bid: np.array([self.body_u(bid, pos)])})
-        p = Poses(theta={bid: np.array([ang[i]])})
-        if self.kind[bid] == "link":
-            p.xy[bid] = (np.array([pos[i, 0] - rx]), np.array([pos[i, 1] - ry]))
-        return p
+        return body_kind(self.kind[bid]).scene_pose(self, bid, self._pos[bid], pos, ang)
 
     def body_u(self, bid: str, pos) -> float:
         i = self._pos[bid]
@@ -466,7 +382,7 @@ class Scene:
             p.append(t.design_point)
             off.append(t.off)
             g.append((dx / nn, dy / nn))
-            slider.append(self.kind[t.body] == "slider")
+            slider.append(body_kind(self.kind[t.body]).translates)
             axis.append(self.axis.get(t.body, (0.0, 0.0)))
             ref.append((rx, ry))
         self._out_names = names
@@ -501,8 +417,6 @@ class Scene:
         else:
             ref = reference
             self._last_state = {k: float(v[-1]) for k, v in ref.state.items()}
-        from mechc.physics.evaluate import output_signals
-
         ref_out = output_signals(self.mech, ref)
         watched: dict[str, list[float]] = {}
         ts, outs, refs = [], {k: [] for k in self.mech.outputs}, {k: [] for k in
@@ -512,6 +426,7 @@ class Scene:
         quiet_since = None
         total = n_move + n_hold
         final_seen: list[dict] = []
+        followers = [(bid, self.bodies[bid], body_kind(self.kind[bid])) for bid in self.boundary]
         for step in range(1, total + 1):
             t = step * st.dt
             tau = min(1.0, t / st.move_time)
@@ -520,27 +435,10 @@ class Scene:
             want = (s0[0] + x * axis[0], s0[1] + x * axis[1])
             servo.velocity = ((want[0] - servo.position[0]) / st.dt,
                               (want[1] - servo.position[1]) / st.dt)
-            for bid in self.boundary:  # closed-form driven bodies
-                kb = self.bodies[bid]
+            for bid, kb, kind in followers:  # closed-form driven bodies
                 k = frac * (len(samples) - 1)
                 i0 = min(int(k), len(samples) - 2)
-                w = k - i0
-                if self.kind[bid] == "slider":
-                    u = ref.u[bid][i0] * (1 - w) + ref.u[bid][i0 + 1] * w
-                    rx, ry = self.ref[bid]
-                    ax, ay = self.axis[bid]
-                    goal = (rx + u * ax, ry + u * ay)
-                    kb.velocity = ((goal[0] - kb.position[0]) / st.dt,
-                                   (goal[1] - kb.position[1]) / st.dt)
-                else:
-                    th = ref.theta[bid][i0] * (1 - w) + ref.theta[bid][i0 + 1] * w
-                    kb.angular_velocity = (th - kb.angle) / st.dt
-                    if self.kind[bid] == "link":
-                        rx, ry = self.ref[bid]
-                        gx = rx + ref.xy[bid][0][i0] * (1 - w) + ref.xy[bid][0][i0 + 1] * w
-                        gy = ry + ref.xy[bid][1][i0] * (1 - w) + ref.xy[bid][1][i0 + 1] * w
-                        kb.velocity = ((gx - kb.position[0]) / st.dt,
-                                       (gy - kb.position[1]) / st.dt)
+                kind.follow(self, bid, kb, ref, i0, k - i0, st.dt)
             self.space.step(st.dt)
             self._read()
             v = self._violations()

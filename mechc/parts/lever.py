@@ -1,0 +1,60 @@
+"""``lever``: a body turning about a fixed ground ``pivot`` (coordinate ``theta``, rad ccw
+from the design pose); drawn with a ground bearing, held in pymunk by a ground pivot joint."""
+
+from __future__ import annotations
+
+import numpy as np
+import pymunk
+
+from mechc.ir.mechanism import Body, Joint, Point
+from mechc.parts.base import BodyKind, Coords, SceneBuilder, Shape
+from mechc.physics.poses import Poses, cos_sin
+
+
+class Lever(BodyKind):
+    name = "lever"
+    dyad = True
+
+    @classmethod
+    def position(cls, body: Body, poses: Poses, p) -> Coords:
+        """pivot + R(θ)·arm: fewer array passes than point + displacement."""
+        c, s = cos_sin(poses.theta[body.id])
+        rx, ry = p[0] - body.pivot[0], p[1] - body.pivot[1]
+        x, y = rx * c, rx * s
+        x -= ry * s
+        y += ry * c
+        x += body.pivot[0]
+        y += body.pivot[1]
+        return x, y
+
+    @classmethod
+    def arm(cls, body: Body, poses: Poses, p) -> Coords:
+        th = poses.theta[body.id]
+        r = (p[0] - body.pivot[0], p[1] - body.pivot[1])
+        c, s = np.cos(th), np.sin(th)
+        return r[0] * c - r[1] * s, r[0] * s + r[1] * c
+
+    @classmethod
+    def dyad_anchor(cls, body: Body, joints: list[Joint], bodies: dict[str, Body],
+                    poses: Poses):
+        return body.pivot, np.asarray(body.pivot[0]), np.asarray(body.pivot[1]), None, None
+
+    @classmethod
+    def symbols(cls, body: Body) -> list[Shape]:
+        if body.pivot is None:
+            return []
+        return [Shape("pivot", [body.pivot], ref=body.id, ground=(0.0, -1.0))]
+
+    @classmethod
+    def reach(cls, body: Body, stroke: float) -> list[Point]:
+        """The square its largest radius sweeps."""
+        if body.pivot is None:
+            return super().reach(body, stroke)
+        pts = np.array([p for poly in body.outline for p in poly], dtype=float)
+        r = float(np.hypot(pts[:, 0] - body.pivot[0], pts[:, 1] - body.pivot[1]).max())
+        return [(body.pivot[0] - r, body.pivot[1] - r), (body.pivot[0] + r, body.pivot[1] + r)]
+
+    @classmethod
+    def hold(cls, scene: SceneBuilder, body: Body, pm: pymunk.Body, ref: Point) -> None:
+        scene.space.add(pymunk.PivotJoint(scene.space.static_body, pm, ref, (0, 0)))
+        scene.measure(f"{body.id}.pivot", "pivot", -1, ref, scene.order_of(body.id), (0, 0))

@@ -1,0 +1,149 @@
+"""``rod``: a link of ``length`` pinned at ``pa`` on body a and ``pb`` on body b (a massless
+two-force member).
+
+Closed forms: a rod from a known body places a slider (a quadratic, the root zero at the design
+pose) or a lever (where the lever's circle meets the rod's). Drawn as a line between pin
+circles; pymunk's PinJoint."""
+
+from __future__ import annotations
+
+import numpy as np
+import pymunk
+
+from mechc.ir.mechanism import GROUND, Body, Joint
+from mechc.parts.base import (
+    JointKind,
+    Placer,
+    SceneBuilder,
+    Shape,
+    angle_between_lines,
+    cross,
+    lever_arm,
+    placed_key,
+    placed_position,
+    position,
+)
+from mechc.physics.poses import Poses
+
+
+def slider_from_rod(j: Joint, slider: Body, other: Body | None, poses: Poses,
+                    size: int) -> None:
+    """A rod of fixed length between a known body and the slider: the root that is zero at the
+    design pose (the branch the mechanism is built on)."""
+    mine, theirs = (j.pb, j.pa) if j.b == slider.id else (j.pa, j.pb)
+    ox, oy = position(other, poses, theirs)
+    wx, wy = mine[0] - ox, mine[1] - oy
+    e = slider.axis
+    we = wx * e[0] + wy * e[1]
+    disc = we * we - (wx * wx + wy * wy) + j.length ** 2
+    we0 = (mine[0] - theirs[0]) * e[0] + (mine[1] - theirs[1]) * e[1]
+    s = 1.0 if we0 >= 0 else -1.0
+    ok = disc >= 0
+    u = -we + s * np.sqrt(np.where(ok, disc, 0.0))
+    poses.u[slider.id] = np.where(ok, u, np.nan) * np.ones(size)
+    poses.mark(slider.id, ~np.broadcast_to(ok, (size,))
+               | np.broadcast_to(poses.bad.get(other.id if other else GROUND,
+                                               np.zeros(size, bool)), (size,)))
+    # rod direction against the slider's travel
+    px, py = mine[0] + poses.u[slider.id] * e[0] - ox, mine[1] + poses.u[slider.id] * e[1] - oy
+    alpha = angle_between_lines(px, py, e[0], e[1])
+    mu = 90.0 - alpha
+    arm = lever_arm(other, poses, theirs)
+    if arm is not None:  # the lever arm's side of the pair
+        mu = np.minimum(mu, angle_between_lines(arm[0], arm[1], px, py))
+    poses.transmission[j.id] = mu * np.ones(size)
+    poses.singular_margin[j.id] = mu * np.ones(size)
+
+
+def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
+                   size: int) -> None:
+    """A rod from a known body to a pin on the lever: the pin is where the lever's circle
+    (about its pivot) meets the rod's circle (about the known end), on the side of the line of
+    centres the design pose is on.
+
+    Worked in units of the centre distance d (D = rod end - pivot): the pin sits at
+    A·D ± H·D⊥ from the pivot with A = 1/2 + (r² - L²)/(2d²) and H² = r²/d² - A², so one
+    division, one square root and one arctan2 place it; the transmission angle comes from the
+    same numbers (law of cosines: arm·rod = (d² - r² - L²)/2, |arm×rod| = H·d²) by arctan2,
+    which unlike arccos of a cosine stays accurate at the toggle (H -> 0)."""
+    mine, theirs = (j.pb, j.pa) if j.b == lever.id else (j.pa, j.pb)
+    P = lever.pivot
+    r2 = (mine[0] - P[0]) ** 2 + (mine[1] - P[1]) ** 2
+    L2 = j.length * j.length
+    cx, cy = position(other, poses, theirs)
+    dx, dy = cx - P[0], cy - P[1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / (dx * dx + dy * dy)  # d = 0 or NaN: A, H2 NaN below, the state is bad
+        A = 0.5 * (r2 - L2) * inv
+        A += 0.5
+        H2 = r2 * inv - A * A
+        ok = H2 >= 0
+        H = np.sqrt(H2)  # unsolved states (past the toggle): NaN pin, NaN angle
+    side = float(np.sign(cross((theirs[0] - P[0], theirs[1] - P[1]),
+                                (mine[0] - P[0], mine[1] - P[1])))) or 1.0
+    rx, ry = A * dx, A * dy
+    if side > 0:
+        rx -= H * dy
+        ry += H * dx
+    else:
+        rx += H * dy
+        ry -= H * dx
+    phi0 = float(np.arctan2(mine[1] - P[1], mine[0] - P[0]))
+    theta = np.arctan2(ry, rx)
+    theta -= phi0  # in [-pi - phi0, pi - phi0]: wrap the one side that can leave [-pi, pi)
+    if phi0 > 0:
+        np.add(theta, 2 * np.pi, out=theta, where=theta < -np.pi)
+    else:
+        np.subtract(theta, 2 * np.pi, out=theta, where=theta >= np.pi)
+    poses.theta[lever.id] = theta if theta.shape == (size,) else np.broadcast_to(
+        theta, (size,)).copy()
+    other_bad = poses.bad.get(other.id if other else GROUND)
+    bad = ~np.broadcast_to(ok, (size,))
+    poses.mark(lever.id, bad if other_bad is None else bad | other_bad)
+    rx += P[0]
+    ry += P[1]
+    poses.placed[placed_key(lever, mine)] = (rx, ry)
+    if other is not None:
+        poses.placed[placed_key(other, theirs)] = (cx, cy)
+    # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the toggle
+    # (fmax takes 0 over H's NaN there)
+    cos_part = np.abs(0.5 - 0.5 * (r2 + L2) * inv)
+    gamma = np.arctan2(np.fmax(H, 0.0), cos_part)
+    gamma *= 180.0 / np.pi
+    if gamma.shape != (size,):
+        gamma = np.broadcast_to(gamma, (size,)).copy()
+    poses.transmission[j.id] = gamma  # read-only from here on: one array serves both
+    poses.singular_margin[j.id] = gamma
+
+
+class Rod(JointKind):
+    name = "rod"
+    solvers = {("slider", "a"): slider_from_rod, ("slider", "b"): slider_from_rod,
+               ("lever", "a"): lever_from_rod, ("lever", "b"): lever_from_rod}
+
+    @classmethod
+    def violation(cls, j: Joint, a: Body | None, b: Body | None, poses: Poses, size: int,
+                  tol: float) -> np.ndarray:
+        """|distance - length| > 1e-6, squared: no square root."""
+        ax_, ay_ = placed_position(a, poses, j.pa)
+        bx_, by_ = placed_position(b, poses, j.pb)
+        ex, ey = bx_ - ax_, by_ - ay_
+        g2 = ex * ex
+        g2 += ey * ey
+        viol = g2 > (j.length + 1e-6) ** 2
+        if j.length > 1e-6:
+            viol |= g2 < (j.length - 1e-6) ** 2
+        return np.broadcast_to(viol, (size,))
+
+    @classmethod
+    def shapes(cls, j: Joint, at: Placer) -> list[Shape]:
+        return [Shape("rod", [at.pt(j.a, j.pa), at.pt(j.b, j.pb)], ref=j.id)]
+
+    @classmethod
+    def add_to_scene(cls, scene: SceneBuilder, j: Joint) -> None:
+        c = pymunk.PinJoint(scene.body_of(j.a), scene.body_of(j.b), scene.anchor(j.a, j.pa),
+                            scene.anchor(j.b, j.pb))
+        c.distance = j.length
+        scene.measure(j.id, "rod", scene.order_of(j.a), scene.anchor(j.a, j.pa),
+                      scene.order_of(j.b), scene.anchor(j.b, j.pb), (j.length,))
+        scene.space.add(c)
