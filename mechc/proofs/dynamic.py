@@ -33,7 +33,7 @@ from mechc.proofs.accuracy import HALVING_CASES, ErrorModel, choose, confirm, lo
 from mechc.proofs.cases import gray_tour, random_walk
 from mechc.proofs.kinematic import sweep
 from mechc.proofs.prune import FREEZE, blocker, run_case
-from mechc.proofs.registry import Progress, check_interface, engine
+from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings, dyn_settings
 
@@ -52,7 +52,7 @@ def plan(n: int, extra: int, seed: int) -> list[int]:
 
 @engine("dynamic", "combinational")
 def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
-                   progress: Progress | None) -> ProofReport:
+                   progress: OnProgress | None) -> ProofReport:
     """At the solver options given, or with ``accuracy`` at the cheapest settings meeting it."""
     if settings.accuracy is not None:
         return prove_with_accuracy(design, spec, lib, settings.accuracy,

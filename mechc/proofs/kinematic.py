@@ -23,7 +23,7 @@ from mechc.passes.checks import CheckStats
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.proofs.cases import bits, single_changes
-from mechc.proofs.registry import Progress, check_interface, engine
+from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings
 
@@ -98,7 +98,7 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
 
 @engine("kinematic", "combinational")
 def kinematic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
-                     progress: Progress | None) -> ProofReport:
+                     progress: OnProgress | None) -> ProofReport:
     return prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed)
 
 

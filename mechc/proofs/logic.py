@@ -19,7 +19,7 @@ from mechc.ir.design import Design
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, input_matrix
-from mechc.proofs.registry import Progress, check_interface, engine
+from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import LOGIC_FIGURES, ProofReport
 from mechc.proofs.settings import ProofSettings
 
@@ -39,7 +39,7 @@ NEIGHBOUR_CORNERS = 4
 
 @engine("logic", "combinational")
 def logic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
-                 progress: Progress | None) -> ProofReport:
+                 progress: OnProgress | None) -> ProofReport:
     # the sampled check of a wide spec keeps seed 0, as ``mechc simulate`` always has
     return prove_logic(design.netlist, spec)
 

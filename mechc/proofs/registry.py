@@ -20,8 +20,8 @@ from mechc.proofs.settings import ProofSettings
 LEVELS = ("logic", "kinematic", "dynamic")
 KINDS = ("combinational", "sequential")
 #: Called as (done, total) while a long proof runs.
-Progress = Callable[[int, int], None]
-Engine = Callable[[Design, Spec | SeqSpec, Library, ProofSettings, Progress | None], ProofReport]
+OnProgress = Callable[[int, int], None]
+Engine = Callable[[Design, Spec | SeqSpec, Library, ProofSettings, OnProgress | None], ProofReport]
 
 _ENGINES: dict[tuple[str, str], Engine] = {}
 
@@ -58,7 +58,7 @@ def spec_kind(spec: Spec | SeqSpec) -> str:
 
 def prove(design: Design, spec: Spec | SeqSpec, lib: Library, level: str,
           settings: ProofSettings | None = None,
-          progress: Progress | None = None) -> ProofReport:
+          progress: OnProgress | None = None) -> ProofReport:
     """The proof of ``design`` against ``spec`` at ``level``. Refuses, before any work, a
     design whose pins differ from the spec's and a sequential design proved against a
     combinational spec (its memories would be read as logic)."""

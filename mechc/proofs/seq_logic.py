@@ -45,7 +45,7 @@ from mechc.ir.seqspec import (
     stable_graph,
 )
 from mechc.logic.cubes import input_matrix
-from mechc.proofs.registry import Progress, check_interface, engine
+from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import LOGIC_FIGURES, ProofReport
 from mechc.proofs.settings import ProofSettings
 
@@ -220,7 +220,7 @@ def _max_changes(sn: SeqNetlist, out_net: str, x_old: int, x_new: int, q0: int,
 
 @engine("logic", "sequential")
 def sequential_logic_engine(design: Design, spec: SeqSpec, lib: Library,
-                            settings: ProofSettings, progress: Progress | None) -> ProofReport:
+                            settings: ProofSettings, progress: OnProgress | None) -> ProofReport:
     return prove_sequential(design.netlist, spec, seed=settings.seed)
 
 

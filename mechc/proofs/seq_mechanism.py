@@ -26,7 +26,7 @@ from mechc.passes.checks import CheckStats
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
 from mechc.physics.scene import DynSettings, Scene
-from mechc.proofs.registry import Progress, engine
+from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.seq_logic import expected_after, transition_tour
 from mechc.proofs.settings import ProofSettings, dyn_settings
@@ -95,7 +95,7 @@ def _judge_outputs(fails, where, outs_end, outs_path, before, after, tolerance, 
 @engine("kinematic", "sequential")
 def sequential_kinematic_engine(design: Design, spec: SeqSpec, lib: Library,
                                 settings: ProofSettings,
-                                progress: Progress | None) -> ProofReport:
+                                progress: OnProgress | None) -> ProofReport:
     return prove_sequential_kinematic(design, spec, lib, tolerance=settings.tolerance,
                                       seed=settings.seed)
 
@@ -200,7 +200,7 @@ def _last(outs: dict[str, np.ndarray]) -> dict[str, float]:
 @engine("dynamic", "sequential")
 def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
                               settings: ProofSettings,
-                              progress: Progress | None) -> ProofReport:
+                              progress: OnProgress | None) -> ProofReport:
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
                       move_time=settings.move_time)
     return prove_sequential_dynamic(design, spec, lib, settings=st,
