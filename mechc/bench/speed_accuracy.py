@@ -30,6 +30,8 @@ from mechc.proofs.accuracy import MODEL_PATH, ErrorModel, ModelPoint
 from mechc.proofs.dynamic import PRUNE_DEFAULT, prove_dynamic
 from mechc.proofs.kinematic import prove_kinematic
 from mechc.proofs.logic import prove_logic
+from mechc.proofs.report import ProofReport
+from mechc.proofs.settings import dyn_settings
 
 ROOT = Path(__file__).resolve().parents[2]
 _clock = time.process_time  # CPU seconds of this process: the machine is shared, and every
@@ -104,12 +106,12 @@ def _cells(d: Design) -> int:
     return len(d.netlist.cells)
 
 
-def _solver_ok(r: dict) -> bool:
+def _solver_ok(r: ProofReport) -> bool:
     return not any(r["failure_kinds"].get(k) for k in BREAKING)
 
 
 def _dyn(b: Bench, c: Circuit, st: DynSettings, prune: bool | None = None,
-         max_cases: int | None = None, freeze: str | None = None) -> tuple[dict, float]:
+         max_cases: int | None = None, freeze: str | None = None) -> tuple[ProofReport, float]:
     kw = {} if prune is None else {"prune": prune}
     if freeze is not None:
         kw["freeze"] = freeze
@@ -117,10 +119,6 @@ def _dyn(b: Bench, c: Circuit, st: DynSettings, prune: bool | None = None,
     r = prove_dynamic(c.design, c.design.spec, b.lib, st, extra=0,
                       max_cases=max_cases if max_cases is not None else c.max_cases, **kw)
     return r, _clock() - t0
-
-
-def _default_settings(d: Design) -> DynSettings:
-    return DynSettings(violation_limit=0.005 * d.mechanism.ctx.stroke)
 
 
 # ---- 1. every level at its defaults -----------------------------------------------------------
@@ -136,7 +134,7 @@ def levels(b: Bench, cs: list[Circuit]) -> None:
             t0 = _clock()
             kr = _kinematic(b, c)
             tk = _clock() - t0
-            st = _default_settings(d)
+            st = dyn_settings(d)
             t0 = _clock()
             dr = _sequential_dynamic(b, c, st) if c.sequential else _dyn(b, c, st)[0]
             td = _clock() - t0
@@ -178,7 +176,7 @@ def levels(b: Bench, cs: list[Circuit]) -> None:
     b.summary["default_case_seconds"] = round(float(np.mean(per_case)), 4)
 
 
-def _logic(c: Circuit) -> dict:
+def _logic(c: Circuit) -> ProofReport:
     if c.sequential:
         from mechc.proofs.seq_logic import prove_sequential
 
@@ -186,7 +184,7 @@ def _logic(c: Circuit) -> dict:
     return prove_logic(c.design.netlist, c.design.spec)
 
 
-def _kinematic(b: Bench, c: Circuit) -> dict:
+def _kinematic(b: Bench, c: Circuit) -> ProofReport:
     if c.sequential:
         from mechc.proofs.seq_mechanism import prove_sequential_kinematic
 
@@ -194,13 +192,13 @@ def _kinematic(b: Bench, c: Circuit) -> dict:
     return prove_kinematic(c.design, c.design.spec, b.lib)
 
 
-def _sequential_dynamic(b: Bench, c: Circuit, st: DynSettings) -> dict:
+def _sequential_dynamic(b: Bench, c: Circuit, st: DynSettings) -> ProofReport:
     from mechc.proofs.seq_mechanism import prove_sequential_dynamic
 
     return prove_sequential_dynamic(c.design, c.design.spec, b.lib, st)
 
 
-def _kinds(r: dict) -> str:
+def _kinds(r: ProofReport) -> str:
     return " ".join(f"{k}={v}" for k, v in r["failure_kinds"].items())
 
 
@@ -219,8 +217,7 @@ def grid(b: Bench, cs: list[Circuit]) -> list[dict]:
         for dt in dts:
             for it in its:
                 for mt in mts:
-                    st = DynSettings(dt=dt, iterations=it, move_time=mt,
-                                     violation_limit=0.005 * c.design.mechanism.ctx.stroke)
+                    st = dyn_settings(c.design, dt=dt, iterations=it, move_time=mt)
                     r, secs = _dyn(b, c, st, prune=False)
                     out.append(b.row(section="grid", circuit=c.name, level="dynamic",
                                      variant="whole", dt_s=dt, iterations=it, move_time_s=mt,
@@ -281,7 +278,7 @@ def pruning(b: Bench, cs: list[Circuit]) -> None:
                   "scene the last one left)")
             continue
         repeat = 1 if b.quick and _cells(c.design) > 50 else 2
-        st = _default_settings(c.design)
+        st = dyn_settings(c.design)
         best: dict[str, float] = {}
         reports: dict[str, dict] = {}
         for _ in range(repeat):  # interleaved, best of: the machine is shared
@@ -344,7 +341,7 @@ def solver_speedup(b: Bench, c: Circuit, cases: int = 4, steps: int = 150) -> fl
     d, mech = c.design, c.design.mechanism
     names = list(d.spec.inputs)
     n = len(names)
-    st = _default_settings(d)
+    st = dyn_settings(d)
     cur, state = 0, {k: 0.0 for k in names}
     t_whole = t_pruned = 0.0
     for vec in plan(n, 0, 0)[:cases]:
@@ -370,12 +367,10 @@ def solver_speedup(b: Bench, c: Circuit, cases: int = 4, steps: int = 150) -> fl
 def stability_study(b: Bench, c: Circuit) -> dict:
     b.say("\n== stability (full adder, first 4 changes, strong actuators) ==")
     base = stability.strong_actuators(c.design)
-    S = base.mechanism.ctx.stroke
     cases = 4
 
     def run(d, section, **kw):
-        st = DynSettings(violation_limit=0.005 * S,
-                         **{k: v for k, v in kw.items() if k in ("dt", "iterations")})
+        st = dyn_settings(base, **{k: v for k, v in kw.items() if k in ("dt", "iterations")})
         t0 = _clock()
         r = prove_dynamic(d, d.spec, b.lib, st, extra=0, max_cases=cases, prune=False)
         secs = _clock() - t0
@@ -518,7 +513,7 @@ def peers(b: Bench, c: Circuit) -> None:
                   error_fraction=r.max_difference_mm)
     # dynamic level against a bare pymunk scene of the same bodies and joints
     d = c.design
-    st = _default_settings(d)
+    st = dyn_settings(d)
     name = d.spec.inputs[0]
     sc = Scene.build(d.mechanism, b.lib, _types(d), st, {k: 0.0 for k in d.spec.inputs})
     t0 = _clock()

@@ -20,7 +20,7 @@ from mechc.errors import (
     SpecError,
     UsageError,
 )
-from mechc.ui import finite_float, table
+from mechc.ui import finite_float
 
 DESCRIPTION = """\
 mechc compiles logic into mechanisms: a Boolean or sequential specification becomes a netlist of
@@ -120,19 +120,6 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
 SOLVER_OPTIONS = ("dt", "iterations", "move_time")
 
 
-def _solver_settings(args, design):
-    """Default dynamic settings with the solver options the user gave."""
-    from mechc.physics.scene import DynSettings
-
-    st = DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
-                     if design.mechanism else 0.1)
-    for opt in SOLVER_OPTIONS:
-        v = getattr(args, opt)
-        if v is not None:  # checked positive by _check_simulate_options
-            setattr(st, opt, v)
-    return st
-
-
 def _check_simulate_options(args) -> None:
     """Every option range, before any file is read or any proof started."""
     if not 0 < args.tolerance < 0.5:
@@ -164,146 +151,36 @@ def cmd_simulate(args) -> int:
         report = _prove(args, design, spec, lib)
     except UsageError as e:  # the options were checked: this is about the design, name it
         raise UsageError(f"{args.design}: {e}") from None
-    report["design"] = args.design
-    report["spec"] = args.spec or design.spec.path
-    print_report(report, spec)
+    report.source = {"design": args.design, "spec": args.spec or design.spec.path}
+    print(report.summary_text())
     if args.report:
-        write_atomic(args.report, dumps(report))
-    return EXIT_OK if report["passed"] else EXIT_FAILED
+        write_atomic(args.report, dumps(report.to_json()))
+    return EXIT_OK if report.passed else EXIT_FAILED
 
 
-def _prove(args, design, spec, lib) -> dict:
-    """The proof at ``args.level`` of ``design`` against ``spec``: the report."""
-    from mechc.proofs.logic import check_interface
+def _prove(args, design, spec, lib):
+    """The proof at ``args.level`` of ``design`` against ``spec`` (a ProofReport), with a
+    progress bar while a dynamic proof runs."""
+    # imported when used, as every command's modules here: start-up time of the CLI
+    from mechc.proofs import ProofSettings, prove, spec_kind
+    from mechc.ui import Progress
 
-    sequential = getattr(spec, "kind", "") == "fsm"
-    if not sequential and any(c.type == "MEMORY" for c in design.netlist.cells.values()):
-        raise UsageError("a sequential design (with MEMORY cells) is proved against a .fsm spec, "
-                         "not a combinational one")
-    check_interface(design.netlist, spec)  # every level assumes the same pins as the spec
-    if args.level == "logic" and sequential:
-        from mechc.proofs.seq_logic import prove_sequential
+    settings = ProofSettings(tolerance=args.tolerance, seed=args.seed, cases=args.cases,
+                             prune=args.prune, accuracy=args.accuracy, dt=args.dt,
+                             iterations=args.iterations, move_time=args.move_time)
+    if args.level != "dynamic":
+        return prove(design, spec, lib, args.level, settings)
+    what = "sequential dynamic" if spec_kind(spec) == "sequential" else "dynamic"
+    bar = Progress(1, f"{what} proof of {Path(args.design).name}")
 
-        report = prove_sequential(design.netlist, spec, seed=args.seed)
-    elif args.level == "logic":
-        from mechc.proofs.logic import prove_logic
+    def tick(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done, "input changes")
 
-        report = prove_logic(design.netlist, spec)
-    elif args.level == "kinematic" and sequential:
-        from mechc.proofs.seq_mechanism import prove_sequential_kinematic
-
-        report = prove_sequential_kinematic(design, spec, lib, tolerance=args.tolerance,
-                                            seed=args.seed)
-    elif args.level == "dynamic" and sequential:
-        from mechc.proofs.seq_mechanism import prove_sequential_dynamic
-        from mechc.ui import Progress
-
-        bar = Progress(1, f"sequential dynamic proof of {Path(args.design).name}")
-
-        def step(done, total):
-            bar.total = total
-            bar.update(done, "input changes")
-
-        st = None
-        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
-            from mechc.proofs.seq_mechanism import settle_allowance
-
-            st = _solver_settings(args, design)
-            st.settle_time = max(st.settle_time, settle_allowance(design, lib))
-        try:
-            report = prove_sequential_dynamic(design, spec, lib, settings=st,
-                                              tolerance=args.tolerance, seed=args.seed,
-                                              progress=step)
-        finally:
-            bar.close()
-    elif args.level == "kinematic":
-        from mechc.proofs.kinematic import prove_kinematic
-
-        report = prove_kinematic(design, spec, lib, tolerance=args.tolerance, seed=args.seed)
-    else:
-        from mechc.proofs.dynamic import PRUNE_DEFAULT, prove_dynamic
-        from mechc.ui import Progress
-
-        st = _solver_settings(args, design)
-        bar = Progress(1, f"dynamic proof of {Path(args.design).name}")
-
-        def tick(done, total):
-            bar.total = total
-            bar.update(done, "input changes")
-
-        try:
-            if args.accuracy is not None:
-                from mechc.proofs.accuracy import prove_with_accuracy
-
-                report = prove_with_accuracy(design, spec, lib, args.accuracy,
-                                             tolerance=args.tolerance, extra=args.cases,
-                                             seed=args.seed, progress=tick,
-                                             prune=args.prune)
-            else:
-                report = prove_dynamic(design, spec, lib, st, tolerance=args.tolerance,
-                                       extra=args.cases, seed=args.seed, progress=tick,
-                                       prune=args.prune or PRUNE_DEFAULT)
-        finally:
-            bar.close()
-    return report
-
-
-SUMMARY_KEYS = [
-    ("cases", "input states / changes"), ("transitions", "single-input changes"),
-    ("max_position_error_fraction", "max output error vs closed form (fraction of stroke)"),
-    ("max_deviation_fraction", "max output deviation from spec (fraction of stroke)"),
-    ("min_margin_fraction", "min margin to mid-stroke (fraction of stroke)"),
-    ("max_joint_violation_mm", "max joint violation (mm)"),
-    ("max_contact_penetration_mm", "max contact overrun (mm)"),
-    ("max_settle_time_s", "max settle time (s)"),
-    ("min_transmission_angle_deg", "min transmission angle (deg)"),
-    ("min_toggle_distance_deg", "min distance from toggle (deg)"),
-    ("seconds", "seconds"),
-]
-
-
-def print_report(report: dict, spec) -> None:
-    rows = [[label, report[k]] for k, label in SUMMARY_KEYS if report.get(k) is not None]
-    print(table(rows, ["level " + report["level"], "value"]))
-    if report.get("accuracy"):
-        from mechc.proofs.accuracy import describe
-
-        print(describe(report["accuracy"]))
-    verdict = "PASSED" if report["passed"] else "FAILED"
-    kinds = report.get("failure_kinds")
-    extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
-    print(f"{verdict}: level {report['level']}, {report['cases']} cases, "
-          f"{report['failure_count']} failures{extra}, {report['seconds']:.3f} s")
-    for f in report["failures"][:10]:
-        print("  " + _failure_text(f))
-    if report["failure_count"] > 10:
-        print(f"  ... and {report['failure_count'] - 10} more (see --report)")
-    hazards = (report.get("sequential") or {}).get("hazards") or []
-    if hazards:  # timing the logic cannot remove: what the mechanism must respect
-        print(f"ordering requirements ({len(hazards)}; the kinematic and dynamic levels check "
-              "them):")
-        for h in hazards[:10]:
-            print(f"  {h['kind']}: {h['requires']}")
-
-
-def _failure_text(f: dict) -> str:
-    if "message" in f and "inputs" not in f:
-        return f["message"]
-    ins = " ".join(f"{k}={v}" for k, v in f.get("inputs", {}).items())
-    kind = f.get("kind", "")
-    if kind in ("", "rest") and "got" in f:
-        return f"{f['output']}: expected {f['expected']}, got {f['got']} at {ins}"
-    head = f"{kind}: "
-    if "moving" in f:
-        head += f"{f['moving']} -> {f.get('to', '')} " if "to" in f else f"{f['moving']} moving "
-    if "output" in f:
-        head += f"output {f['output']} (expected {f['expected']}) "
-        for key in ("position", "max_deviation", "max_deviation_fraction", "deviation_fraction"):
-            if key in f:
-                head += f"{key.replace('_', ' ')} {f[key]} "
-    if "message" in f:
-        head += f["message"] + " "
-    return head + f"at {ins}"
+    try:
+        return prove(design, spec, lib, args.level, settings, tick)
+    finally:
+        bar.close()
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -18,7 +18,7 @@ import numpy as np
 import pymunk
 
 from mechc.ir.mechanism import GROUND, Body, Joint, Point
-from mechc.physics.poses import Poses, cos_sin
+from mechc.parts.poses import Poses, cos_sin
 
 N = 1000.0  # newtons -> pymunk force units (kg mm / s^2)
 

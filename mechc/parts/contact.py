@@ -14,7 +14,7 @@ import pymunk
 
 from mechc.ir.mechanism import GROUND, Body, Joint, Point
 from mechc.parts.base import JointKind, Placer, SceneBuilder, Shape, direction, position
-from mechc.physics.poses import Poses
+from mechc.parts.poses import Poses
 
 FAR = 1000.0  # mm: how far behind a contact face its slide-joint anchor sits
 

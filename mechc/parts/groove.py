@@ -21,7 +21,7 @@ from mechc.parts.base import (
     position,
     unit,
 )
-from mechc.physics.poses import KinematicsError, Poses
+from mechc.parts.poses import KinematicsError, Poses
 
 
 def lever_from_slot(j: Joint, lever: Body, slot_body: Body | None, poses: Poses,

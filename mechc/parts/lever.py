@@ -8,7 +8,7 @@ import pymunk
 
 from mechc.ir.mechanism import Body, Joint, Point
 from mechc.parts.base import BodyKind, Coords, SceneBuilder, Shape
-from mechc.physics.poses import Poses, cos_sin
+from mechc.parts.poses import Poses, cos_sin
 
 
 class Lever(BodyKind):

@@ -16,7 +16,7 @@ from mechc.parts.base import (
     position,
     turned,
 )
-from mechc.physics.poses import Poses
+from mechc.parts.poses import Poses
 
 
 class Link(BodyKind):

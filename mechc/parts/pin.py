@@ -10,7 +10,7 @@ import pymunk
 
 from mechc.ir.mechanism import Body, Joint
 from mechc.parts.base import JointKind, SceneBuilder, position
-from mechc.physics.poses import Poses
+from mechc.parts.poses import Poses
 
 
 class Pin(JointKind):

@@ -23,7 +23,7 @@ from mechc.parts.base import (
     placed_position,
     position,
 )
-from mechc.physics.poses import Poses
+from mechc.parts.poses import Poses
 
 
 def slider_from_rod(j: Joint, slider: Body, other: Body | None, poses: Poses,

@@ -7,7 +7,7 @@ import pymunk
 
 from mechc.ir.mechanism import Body, Point
 from mechc.parts.base import BodyKind, SceneBuilder
-from mechc.physics.poses import Poses
+from mechc.parts.poses import Poses
 
 
 class Rotor(BodyKind):

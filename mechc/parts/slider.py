@@ -10,7 +10,7 @@ import pymunk
 
 from mechc.ir.mechanism import Body, Point
 from mechc.parts.base import BodyKind, Coords, N, SceneBuilder
-from mechc.physics.poses import Poses
+from mechc.parts.poses import Poses
 
 
 class Slider(BodyKind):

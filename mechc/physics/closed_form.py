@@ -20,7 +20,7 @@ import numpy as np
 from mechc.ir.mechanism import GROUND, Body, Joint, Part
 from mechc.parts import body_kind, joint_kind
 from mechc.parts.base import angle_between_lines, body_or_ground, cross, displacement, position
-from mechc.physics.poses import KinematicsError, Poses, cos_sin
+from mechc.parts.poses import KinematicsError, Poses, cos_sin
 
 # the closed form's public names (``Poses``, ``position``, ... live with the parts and poses)
 __all__ = ["KinematicsError", "Poses", "cos_sin", "displacement", "position", "solve",

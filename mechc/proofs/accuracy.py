@@ -12,16 +12,17 @@ A choice is only a prediction from other circuits, so :func:`confirm` measures i
 itself: the proof's own error against the closed form, and a step-halving check (the first
 changes run again at half the time step; for a first-order method the error of the coarse run
 is about twice the difference between the two). Both must stay within the requested error.
+:func:`mechc.proofs.dynamic.prove_with_accuracy` runs the proof that way.
 """
 
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from mechc.errors import UsageError
-from mechc.physics.scene import DynSettings
 
 MODEL_PATH = Path(__file__).with_name("accuracy_model.json")
 SAFETY = 0.5  # choose settings whose modelled error is at most this share of the request
@@ -93,11 +94,6 @@ def choose(target: float, model: ErrorModel, safety: float = SAFETY) -> ModelPoi
     return min(ok, key=lambda p: (p.cost(model.overhead_iterations), p.error))
 
 
-def settings_for(point: ModelPoint, stroke: float) -> DynSettings:
-    return DynSettings(dt=point.dt, iterations=point.iterations, move_time=point.move_time,
-                       violation_limit=0.005 * stroke)
-
-
 def halving_error(coarse: list[dict], fine: list[dict]) -> float:
     """Estimated error of the coarse run from the same changes run at half the step."""
     worst = 0.0
@@ -109,7 +105,7 @@ def halving_error(coarse: list[dict], fine: list[dict]) -> float:
     return worst
 
 
-def confirm(target: float, report: dict, coarse: list[dict], fine: list[dict]) -> dict:
+def confirm(target: float, report: Mapping, coarse: list[dict], fine: list[dict]) -> dict:
     """Whether the run met the requested error: its error against the closed form, the
     step-halving estimate, and no solver breakdown."""
     err = float(report["max_position_error_fraction"])
@@ -123,49 +119,3 @@ def confirm(target: float, report: dict, coarse: list[dict], fine: list[dict]) -
             "obtained_fraction": round(obtained, 6),
             "solver_breakdown": broke,
             "confirmed": obtained <= target and not broke}
-
-
-def prove_with_accuracy(design, spec, lib, target: float, model: ErrorModel | None = None,
-                        **kw) -> dict:
-    """``prove_dynamic`` at the cheapest settings meeting ``target``, confirmed on the run;
-    the report says which settings, what error was obtained, and fails if it was not met."""
-    from mechc.proofs.dynamic import prove_dynamic
-
-    model = model or load_model()
-    point = choose(target, model)
-    st = settings_for(point, design.mechanism.ctx.stroke)
-    coarse: list[dict] = []
-    report = prove_dynamic(design, spec, lib, st, record=coarse, **kw)
-    half = DynSettings(**{**st.__dict__, "dt": st.dt / 2})
-    fine: list[dict] = []
-    kw_half = {k: v for k, v in kw.items() if k != "progress"}
-    prove_dynamic(design, spec, lib, half, record=fine, max_cases=HALVING_CASES, **kw_half)
-    check = confirm(target, report, coarse[:HALVING_CASES], fine)
-    check["chosen"] = {"dt_s": point.dt, "iterations": point.iterations,
-                       "move_time_s": point.move_time, "model_error_fraction": point.error,
-                       "cost_per_change": round(point.cost(model.overhead_iterations), 1)}
-    report["accuracy"] = check
-    if not check["confirmed"]:
-        report["passed"] = False
-        report["failure_count"] += 1
-        report.setdefault("failure_kinds", {})["accuracy"] = 1
-        report["failures"].insert(0, {
-            "kind": "accuracy",
-            "message": f"accuracy not confirmed: obtained {check['obtained_fraction']:.4g} of "
-                       f"stroke (closed form {check['error_vs_closed_form_fraction']:.4g}, "
-                       f"step halving {check['halving_estimate_fraction']:.4g}) against the "
-                       f"requested {target:g}"})
-    return report
-
-
-def describe(check: dict) -> str:
-    """Two lines for the terminal: settings used, error obtained."""
-    c = check["chosen"]
-    verdict = "confirmed" if check["confirmed"] else "NOT confirmed"
-    return (f"accuracy {check['target_fraction']:g} of stroke: dt {c['dt_s']:g} s, "
-            f"{c['iterations']} iterations, move time {c['move_time_s']:g} s (model error "
-            f"{c['model_error_fraction']:.3g})\n"
-            f"  obtained {check['obtained_fraction']:.4g} (closed form "
-            f"{check['error_vs_closed_form_fraction']:.4g}, step halving "
-            f"{check['halving_estimate_fraction']:.4g} on {check['halving_cases']} changes): "
-            f"{verdict}")

@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -28,10 +29,13 @@ from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
 from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, Scene
+from mechc.proofs.accuracy import HALVING_CASES, ErrorModel, choose, confirm, load_model
 from mechc.proofs.cases import gray_tour, random_walk
 from mechc.proofs.kinematic import sweep
-from mechc.proofs.logic import check_interface
 from mechc.proofs.prune import FREEZE, blocker, run_case
+from mechc.proofs.registry import OnProgress, check_interface, engine
+from mechc.proofs.report import ProofReport
+from mechc.proofs.settings import ProofSettings, dyn_settings
 
 MAX_LISTED = 50
 PRUNE_DEFAULT = False  # per-change pruned scenes (mechc.proofs.prune); see docs/performance.md
@@ -46,12 +50,27 @@ def plan(n: int, extra: int, seed: int) -> list[int]:
     return tour + walk
 
 
+@engine("dynamic", "combinational")
+def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
+                   progress: OnProgress | None) -> ProofReport:
+    """At the solver options given, or with ``accuracy`` at the cheapest settings meeting it."""
+    if settings.accuracy is not None:
+        return prove_with_accuracy(design, spec, lib, settings.accuracy,
+                                   tolerance=settings.tolerance, extra=settings.cases,
+                                   seed=settings.seed, progress=progress, prune=settings.prune)
+    st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time)
+    return prove_dynamic(design, spec, lib, st, tolerance=settings.tolerance,
+                         extra=settings.cases, seed=settings.seed, progress=progress,
+                         prune=settings.prune or PRUNE_DEFAULT)
+
+
 def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSettings | None = None,
                   tolerance: float = 0.05, extra: int = 16, seed: int = 0,
                   progress: Callable[[int, int], None] | None = None,
                   cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
                   max_cases: int | None = None, record: list | None = None,
-                  freeze: str | None = None) -> dict:
+                  freeze: str | None = None) -> ProofReport:
     """``prune``: each change runs on its own scene holding only what can move the outputs
     (``mechc.proofs.prune``; every change then starts from the closed-form rest pose); else one
     scene of the whole mechanism (or of ``cells``) runs the whole tour. ``max_cases`` keeps
@@ -59,8 +78,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     final output positions (for step-halving checks); ``freeze``: which still bodies a pruned
     scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``)."""
     t0 = time.perf_counter()
-    st = settings or DynSettings(violation_limit=0.005 * design.mechanism.ctx.stroke
-                                 if design.mechanism else 0.1)
+    st = settings or dyn_settings(design)
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
     check_interface(design.netlist, spec)
@@ -163,31 +181,57 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                              "value": round(c.value, 6), "limit": c.limit,
                              "message": c.text()})
     total_fail = sum(counts.values()) + len(bad_checks)
-    return {
-        "passed": total_fail == 0,
-        "level": "dynamic",
-        "cases": len(vectors),
-        "tour": min(len(vectors), (1 << n) - 1) if n <= 10 else 0,
-        "random_changes": extra,
-        "seed": seed,
-        "tolerance_fraction": tolerance,
-        "failure_count": total_fail,
-        "failure_kinds": {k: v for k, v in counts.items() if v},
-        "failures": failures,
-        "max_position_error_fraction": round(max_err, 6),
-        "max_deviation_fraction": round(max_dev, 6),
-        "min_margin_fraction": round(0.5 - max_dev, 6),
-        "max_joint_violation_mm": round(max_vio, 6),
-        "worst_joint": worst_joint,
-        "max_contact_penetration_mm": round(max_pen, 6),
-        "max_settle_time_s": round(max_settle, 5),
-        "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
-        "steps": steps,
-        "scene": _scene_json(scene, sizes),
-        "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order), freeze),
-        "settings": st.to_json(),
-        "seconds": round(time.perf_counter() - t0, 4),
-    }
+    return ProofReport(
+        level="dynamic", kind="combinational", passed=total_fail == 0, cases=len(vectors),
+        coverage={"tour": min(len(vectors), (1 << n) - 1) if n <= 10 else 0,
+                  "random_changes": extra, "seed": seed, "tolerance_fraction": tolerance},
+        failure_count=total_fail, failure_kinds={k: v for k, v in counts.items() if v},
+        failures=failures,
+        figures={
+            "max_position_error_fraction": round(max_err, 6),
+            "max_deviation_fraction": round(max_dev, 6),
+            "min_margin_fraction": round(0.5 - max_dev, 6),
+            "max_joint_violation_mm": round(max_vio, 6),
+            "worst_joint": worst_joint,
+            "max_contact_penetration_mm": round(max_pen, 6),
+            "max_settle_time_s": round(max_settle, 5),
+            "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
+            "steps": steps,
+            "scene": _scene_json(scene, sizes),
+            "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order),
+                                     freeze),
+            "settings": st.to_json(),
+        },
+        seconds=round(time.perf_counter() - t0, 4))
+
+
+def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
+                        model: ErrorModel | None = None, **kw) -> ProofReport:
+    """``prove_dynamic`` at the cheapest settings meeting ``target``
+    (:mod:`mechc.proofs.accuracy`), confirmed on the run; the report says which settings, what
+    error was obtained, and fails if it was not met."""
+    model = model or load_model()
+    point = choose(target, model)
+    st = dyn_settings(design, dt=point.dt, iterations=point.iterations,
+                      move_time=point.move_time)
+    coarse: list[dict] = []
+    report = prove_dynamic(design, spec, lib, st, record=coarse, **kw)
+    half = replace(st, dt=st.dt / 2)
+    fine: list[dict] = []
+    kw_half = {k: v for k, v in kw.items() if k != "progress"}
+    prove_dynamic(design, spec, lib, half, record=fine, max_cases=HALVING_CASES, **kw_half)
+    check = confirm(target, report, coarse[:HALVING_CASES], fine)
+    check["chosen"] = {"dt_s": point.dt, "iterations": point.iterations,
+                       "move_time_s": point.move_time, "model_error_fraction": point.error,
+                       "cost_per_change": round(point.cost(model.overhead_iterations), 1)}
+    report.accuracy = check
+    if not check["confirmed"]:
+        report.add_failure(
+            "accuracy",
+            f"accuracy not confirmed: obtained {check['obtained_fraction']:.4g} of stroke "
+            f"(closed form {check['error_vs_closed_form_fraction']:.4g}, step halving "
+            f"{check['halving_estimate_fraction']:.4g}) against the requested {target:g}")
+    return report
 
 
 def _scene_json(scene: Scene | None, sizes: list[tuple[int, int, int]]) -> dict:

@@ -23,7 +23,9 @@ from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.physics.measures import CheckStats
 from mechc.proofs.cases import bits, single_changes
-from mechc.proofs.logic import check_interface
+from mechc.proofs.registry import OnProgress, check_interface, engine
+from mechc.proofs.report import ProofReport
+from mechc.proofs.settings import ProofSettings
 
 EXHAUSTIVE_MAX_INPUTS = 10
 MAX_LISTED = 50
@@ -94,8 +96,14 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
                 exhaustive=exhaustive)
 
 
+@engine("kinematic", "combinational")
+def kinematic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
+                     progress: OnProgress | None) -> ProofReport:
+    return prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed)
+
+
 def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float = 0.05,
-                    samples: int = 21, seed: int = 0) -> dict:
+                    samples: int = 21, seed: int = 0) -> ProofReport:
     t0 = time.perf_counter()
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
@@ -156,27 +164,25 @@ def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float =
                                  "value": _num(c.value), "limit": c.limit, "message": c.text()})
     mus = [c.value for c in checks if c.name == "transmission angle"]
     sing = [c.value for c in checks if c.name == "distance from toggle"]
-    return {
-        "passed": fail_count == 0,
-        "level": "kinematic",
-        "cases": int(rest_bits.shape[1]),
-        "transitions": int(len(e_k)),
-        "samples_per_transition": sw["samples"],
-        "exhaustive": sw["exhaustive"],
-        "tolerance_fraction": tolerance,
-        "failure_count": fail_count,
-        "failures": failures,
-        "max_deviation_fraction": round(max_dev, 9),
-        # the closed forms are the reference the dynamic level is measured against, and their
-        # joints close exactly (states where one cannot are counted as unsolvable checks)
-        "max_position_error_fraction": 0.0,
-        "max_joint_violation_mm": 0.0,
-        "min_margin_fraction": round(min_margin, 9),
-        "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
-        "min_toggle_distance_deg": round(min(sing), 4) if sing else None,
-        "checks": [c.to_json() for c in checks],
-        "seconds": round(time.perf_counter() - t0, 4),
-    }
+    return ProofReport(
+        level="kinematic", kind="combinational", passed=fail_count == 0,
+        cases=int(rest_bits.shape[1]),
+        coverage={"transitions": int(len(e_k)), "samples_per_transition": sw["samples"],
+                  "exhaustive": sw["exhaustive"], "tolerance_fraction": tolerance},
+        failure_count=fail_count, failures=failures,
+        figures={
+            "max_deviation_fraction": round(max_dev, 9),
+            # the closed forms are the reference the dynamic level is measured against, and
+            # their joints close exactly (states where one cannot are counted as unsolvable
+            # checks)
+            "max_position_error_fraction": 0.0,
+            "max_joint_violation_mm": 0.0,
+            "min_margin_fraction": round(min_margin, 9),
+            "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
+            "min_toggle_distance_deg": round(min(sing), 4) if sing else None,
+            "checks": [c.to_json() for c in checks],
+        },
+        seconds=round(time.perf_counter() - t0, 4))
 
 
 def _vec(column: np.ndarray, names: list[str]) -> dict[str, int]:

@@ -13,10 +13,15 @@ import time
 
 import numpy as np
 
+from mechc.cells.library import Library
 from mechc.errors import UsageError
+from mechc.ir.design import Design
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, input_matrix
+from mechc.proofs.registry import OnProgress, check_interface, engine
+from mechc.proofs.report import LOGIC_FIGURES, ProofReport
+from mechc.proofs.settings import ProofSettings
 
 MAX_LISTED_FAILURES = 50
 #: Wide specs: cubes with at most this many free inputs have every point checked.
@@ -32,17 +37,14 @@ RANDOM_VECTORS = 1 << 16
 NEIGHBOUR_CORNERS = 4
 
 
-def check_interface(nl: Netlist, spec: Spec) -> None:
-    if set(nl.inputs) != set(spec.inputs):
-        raise UsageError(f"design inputs ({' '.join(nl.inputs)}) differ from the spec's "
-                         f"({' '.join(spec.inputs)})")
-    missing = [o for o in spec.outputs if o not in nl.outputs]
-    if missing:
-        raise UsageError(f"spec output(s) {', '.join(missing)} not in the design (design outputs:"
-                         f" {' '.join(nl.outputs)})")
+@engine("logic", "combinational")
+def logic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
+                 progress: OnProgress | None) -> ProofReport:
+    # the sampled check of a wide spec keeps seed 0, as ``mechc simulate`` always has
+    return prove_logic(design.netlist, spec)
 
 
-def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> dict:
+def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> ProofReport:
     t0 = time.perf_counter()
     check_interface(nl, spec)
     if spec.n > MAX_TABLE_INPUTS:
@@ -53,19 +55,11 @@ def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> dict:
     nets = nl.evaluate(env)
     wants = {o: spec.table(o) for o in spec.outputs}
     failures, total_bad, care_cases = _compare(nl, spec, nets, wants, env)
-    return {
-        "passed": total_bad == 0,
-        "level": "logic",
-        "cases": 1 << n,
-        "exhaustive": True,
-        "care_checks": care_cases,
-        "failure_count": total_bad,
-        "failures": failures,
-        # positions, margins and joints are not defined at the logic level
-        "max_position_error_fraction": None, "min_margin_fraction": None,
-        "max_joint_violation_mm": None, "min_transmission_angle_deg": None,
-        "seconds": round(time.perf_counter() - t0, 6),
-    }
+    return ProofReport(
+        level="logic", kind="combinational", passed=total_bad == 0, cases=1 << n,
+        coverage={"exhaustive": True, "care_checks": care_cases},
+        failure_count=total_bad, failures=failures, figures=dict(LOGIC_FIGURES),
+        seconds=round(time.perf_counter() - t0, 6))
 
 
 def _compare(nl: Netlist, spec: Spec, nets: dict, wants: dict[str, np.ndarray],
@@ -90,7 +84,7 @@ def _compare(nl: Netlist, spec: Spec, nets: dict, wants: dict[str, np.ndarray],
     return failures, total_bad, care_cases
 
 
-def _check_sampled(nl: Netlist, spec: Spec, t0: float, seed: int) -> dict:
+def _check_sampled(nl: Netlist, spec: Spec, t0: float, seed: int) -> ProofReport:
     """Compare netlist and spec on cube points and random vectors (n too large to enumerate)."""
     n = spec.n
     for o in spec.outputs:
@@ -122,20 +116,13 @@ def _check_sampled(nl: Netlist, spec: Spec, t0: float, seed: int) -> dict:
         want[_member(X, f.dc, n)] = DC
         wants[o] = want
     failures, total_bad, care_cases = _compare(nl, spec, nets, wants, values)
-    return {
-        "passed": total_bad == 0,
-        "level": "logic",
-        "cases": len(vectors),
-        "exhaustive": False,
-        "sampling": {"cube_vectors": len(from_cubes), "random_vectors": RANDOM_VECTORS,
-                     "corner_free_max": CORNER_FREE_MAX, "seed": seed},
-        "care_checks": care_cases,
-        "failure_count": total_bad,
-        "failures": failures,
-        "max_position_error_fraction": None, "min_margin_fraction": None,
-        "max_joint_violation_mm": None, "min_transmission_angle_deg": None,
-        "seconds": round(time.perf_counter() - t0, 6),
-    }
+    sampling = {"cube_vectors": len(from_cubes), "random_vectors": RANDOM_VECTORS,
+                "corner_free_max": CORNER_FREE_MAX, "seed": seed}
+    return ProofReport(
+        level="logic", kind="combinational", passed=total_bad == 0, cases=len(vectors),
+        coverage={"exhaustive": False, "sampling": sampling, "care_checks": care_cases},
+        failure_count=total_bad, failures=failures, figures=dict(LOGIC_FIGURES),
+        seconds=round(time.perf_counter() - t0, 6))
 
 
 def _cube_vectors(cubes: list[Cube], n: int, rng: np.random.Generator) -> set[int]:

@@ -27,7 +27,9 @@ from collections import deque
 
 import numpy as np
 
+from mechc.cells.library import Library
 from mechc.errors import UsageError
+from mechc.ir.design import Design
 from mechc.ir.logic_types import evaluate_type
 from mechc.ir.netlist import Netlist
 from mechc.ir.seqspec import (
@@ -43,7 +45,9 @@ from mechc.ir.seqspec import (
     stable_graph,
 )
 from mechc.logic.cubes import input_matrix
-from mechc.proofs.logic import check_interface
+from mechc.proofs.registry import OnProgress, check_interface, engine
+from mechc.proofs.report import LOGIC_FIGURES, ProofReport
+from mechc.proofs.settings import ProofSettings
 
 X = 2  # the ternary "moving" value
 MAX_LISTED = 50
@@ -214,7 +218,13 @@ def _max_changes(sn: SeqNetlist, out_net: str, x_old: int, x_new: int, q0: int,
     return first + best(q0)
 
 
-def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> dict:
+@engine("logic", "sequential")
+def sequential_logic_engine(design: Design, spec: SeqSpec, lib: Library,
+                            settings: ProofSettings, progress: OnProgress | None) -> ProofReport:
+    return prove_sequential(design.netlist, spec, seed=settings.seed)
+
+
+def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> ProofReport:
     """The logic-level proof (exhaustive over every specified transition)."""
     t0 = time.perf_counter()
     check_interface(nl, spec)
@@ -373,24 +383,17 @@ def _group(hazards: list[dict]) -> list[dict]:
     return list(out.values())
 
 
-def _report(spec, t0, failures, kinds, hazards, states, transitions, m) -> dict:
+def _report(spec, t0, failures, kinds, hazards, states, transitions, m) -> ProofReport:
     count = sum(kinds.values())
     hazards = _group(hazards)
-    return {
-        "passed": count == 0,
-        "level": "logic",
-        "cases": states,
-        "transitions": transitions,
-        "exhaustive": True,
-        "failure_count": count,
-        "failure_kinds": dict(sorted(kinds.items())),
-        "failures": failures,
-        "sequential": {"form": spec.form, "stable_states": states, "transitions": transitions,
-                       "memories": m, "hazards": hazards},
-        "max_position_error_fraction": None, "min_margin_fraction": None,
-        "max_joint_violation_mm": None, "min_transmission_angle_deg": None,
-        "seconds": round(time.perf_counter() - t0, 6),
-    }
+    return ProofReport(
+        level="logic", kind="sequential", passed=count == 0, cases=states,
+        coverage={"transitions": transitions, "exhaustive": True},
+        failure_count=count, failure_kinds=dict(sorted(kinds.items())), failures=failures,
+        figures={"sequential": {"form": spec.form, "stable_states": states,
+                                "transitions": transitions, "memories": m, "hazards": hazards},
+                 **LOGIC_FIGURES},
+        seconds=round(time.perf_counter() - t0, 6))
 
 
 # ---- walks for the kinematic and dynamic levels -----------------------------------------------

@@ -21,11 +21,15 @@ import numpy as np
 from mechc.cells.library import Library
 from mechc.errors import UsageError
 from mechc.ir.design import Design
+from mechc.ir.seqspec import SeqSpec
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
 from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, Scene
+from mechc.proofs.registry import OnProgress, engine
+from mechc.proofs.report import ProofReport
 from mechc.proofs.seq_logic import expected_after, transition_tour
+from mechc.proofs.settings import ProofSettings, dyn_settings
 
 MAX_LISTED = 50
 
@@ -88,9 +92,17 @@ def _judge_outputs(fails, where, outs_end, outs_path, before, after, tolerance, 
                           max_deviation=round(glitch, 6))
 
 
+@engine("kinematic", "sequential")
+def sequential_kinematic_engine(design: Design, spec: SeqSpec, lib: Library,
+                                settings: ProofSettings,
+                                progress: OnProgress | None) -> ProofReport:
+    return prove_sequential_kinematic(design, spec, lib, tolerance=settings.tolerance,
+                                      seed=settings.seed)
+
+
 def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float = 0.05,
                                samples: int = 21, seed: int = 0, random_walks: int = 4,
-                               stats: CheckStats | None = None) -> dict:
+                               stats: CheckStats | None = None) -> ProofReport:
     """Walk the closed form through the spec's sequences (each step sampled along the moving
     input, the stateful cells settled at every sample)."""
     try:
@@ -102,7 +114,7 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
 
 def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float,
                                 samples: int, seed: int, random_walks: int,
-                                stats: CheckStats | None) -> dict:
+                                stats: CheckStats | None) -> ProofReport:
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)
     mems = stateful_cells(design, lib)
@@ -141,39 +153,15 @@ def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: f
             state = path_state
             cur = {n: float(v) for n, v in seq[k].items()}
             steps += 1
-    return {"passed": fails.total == 0, "level": "kinematic",
-            "steps": steps, "cases": steps, "memories": len(mems),
-            "tolerance_fraction": tolerance,
-            "failure_count": fails.total, "failure_kinds": fails.counts,
-            "overlaps_by_cell": {c: n for (k, c), n in fails.by_cell.items()
-                                 if k == "S·R overlap"},
-            "failures": fails.items, "max_deviation_fraction": round(dev[0], 6),
-            "min_margin_fraction": round(0.5 - dev[0], 6),
-            "seconds": round(time.perf_counter() - t0, 3)}
-
-
-#: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
-MEMORY_THROW_S = 0.03
-
-
-def settle_allowance(design: Design, lib: Library) -> float:
-    """How long after an input's move a sequential circuit may still be switching: along the
-    slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
-    transition may pass through every memory in turn. Used as the hold of each change, so a
-    circuit that is slow by design is not reported unsettled (it still must settle)."""
-    import networkx as nx
-
-    nl = design.netlist
-    g = nl.combinational_graph()
-    delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
-             for c in nl.cells.values()}
-    longest: dict[str, float] = {}
-    for node in nx.topological_sort(g):
-        here = max((longest[u] for u in g.predecessors(node)), default=0.0)
-        longest[node] = here + delay.get(node, 0.0)
-    path = max(longest.values(), default=0.0)
-    m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
-    return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
+    return ProofReport(
+        level="kinematic", kind="sequential", passed=fails.total == 0, cases=steps,
+        coverage={"steps": steps, "memories": len(mems), "tolerance_fraction": tolerance},
+        failure_count=fails.total, failure_kinds=fails.counts,
+        overlaps_by_cell={c: n for (k, c), n in fails.by_cell.items() if k == "S·R overlap"},
+        failures=fails.items,
+        figures={"max_deviation_fraction": round(dev[0], 6),
+                 "min_margin_fraction": round(0.5 - dev[0], 6)},
+        seconds=round(time.perf_counter() - t0, 3))
 
 
 def _memory_inputs(mech, lib, types, scene) -> dict[str, tuple[str, str]]:
@@ -209,18 +197,28 @@ def _last(outs: dict[str, np.ndarray]) -> dict[str, float]:
     return {o: float(np.ravel(v)[-1]) for o, v in outs.items()}
 
 
+@engine("dynamic", "sequential")
+def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
+                              settings: ProofSettings,
+                              progress: OnProgress | None) -> ProofReport:
+    st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time)
+    return prove_sequential_dynamic(design, spec, lib, settings=st,
+                                    tolerance=settings.tolerance, seed=settings.seed,
+                                    progress=progress)
+
+
 def prove_sequential_dynamic(design: Design, spec, lib: Library,
                              settings: DynSettings | None = None, tolerance: float = 0.05,
                              seed: int = 0, random_walks: int = 2,
                              progress: Callable[[int, int], None] | None = None,
-                             sequences: list[list[dict[str, int]]] | None = None) -> dict:
+                             sequences: list[list[dict[str, int]]] | None = None) -> ProofReport:
     """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
-    each from the power-up inputs); a fresh scene per sequence starts at power-up."""
+    each from the power-up inputs); a fresh scene per sequence starts at power-up. Without
+    ``settings``, the defaults with the circuit's settle allowance (``dyn_settings``)."""
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)
-    st = settings or DynSettings(violation_limit=0.005 * mech.ctx.stroke)
-    if settings is None:
-        st.settle_time = max(st.settle_time, settle_allowance(design, lib))
+    st = settings or dyn_settings(design, lib)
     walks = (_walks(spec, seed, random_walks) if sequences is None
              else [(s, expected_after(spec, s)) for s in sequences])
     total = sum(len(s) - 1 for s, _ in walks)
@@ -268,14 +266,14 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
             done += 1
             if progress:
                 progress(done, total)
-    return {"passed": fails.total == 0, "level": "dynamic",
-            "cases": done, "sequences": len(walks), "seed": seed,
-            "tolerance_fraction": tolerance, "failure_count": fails.total,
-            "failure_kinds": fails.counts, "failures": fails.items,
-            "max_position_error_fraction": round(max_err, 6),
-            "max_deviation_fraction": round(dev[0], 6),
-            "min_margin_fraction": round(0.5 - dev[0], 6),
-            "max_joint_violation_mm": round(max_vio, 6), "worst_joint": worst,
-            "max_contact_overrun_mm": round(max_pen, 6),
-            "max_settle_time_s": round(max_settle, 6), "settings": st.to_json(),
-            "seconds": round(time.perf_counter() - t0, 3)}
+    return ProofReport(
+        level="dynamic", kind="sequential", passed=fails.total == 0, cases=done,
+        coverage={"sequences": len(walks), "seed": seed, "tolerance_fraction": tolerance},
+        failure_count=fails.total, failure_kinds=fails.counts, failures=fails.items,
+        figures={"max_position_error_fraction": round(max_err, 6),
+                 "max_deviation_fraction": round(dev[0], 6),
+                 "min_margin_fraction": round(0.5 - dev[0], 6),
+                 "max_joint_violation_mm": round(max_vio, 6), "worst_joint": worst,
+                 "max_contact_overrun_mm": round(max_pen, 6),
+                 "max_settle_time_s": round(max_settle, 6), "settings": st.to_json()},
+        seconds=round(time.perf_counter() - t0, 3))

@@ -20,8 +20,8 @@ from mechc.proofs.accuracy import (
     confirm,
     halving_error,
     load_model,
-    prove_with_accuracy,
 )
+from mechc.proofs.dynamic import prove_with_accuracy
 from tests.helpers import EXAMPLES
 
 LIB = load_library()

@@ -15,6 +15,7 @@ from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_spec
 from mechc.proofs.dynamic import plan, prove_dynamic
 from mechc.proofs.prune import blocker, cone, plan_case, run_case
+from mechc.proofs.settings import dyn_settings
 from tests.helpers import EXAMPLES
 
 LIB = load_library()
@@ -110,7 +111,7 @@ def test_pruned_scene_gives_the_whole_scenes_outputs(design, freeze, agree):
     frozen scene has fewer constraints than the same cells kept free."""
     nl, mech = design.netlist, design.mechanism
     types = {c.id: c.cell for c in nl.cells.values()}
-    st = DynSettings(violation_limit=0.005 * mech.ctx.stroke)
+    st = dyn_settings(design)
     smaller = 0
     cases = list(_cases(design, 7))
     for state, name, target in cases:

@@ -19,9 +19,9 @@ from mechc.cells.library import load_library
 from mechc.frontends import load_spec
 from mechc.physics.closed_form import solve
 from mechc.physics.measures import MIN_SINGULAR_MARGIN_DEG
-from mechc.physics.scene import DynSettings
 from mechc.pipeline import compile_spec
 from mechc.proofs.dynamic import prove_dynamic
+from mechc.proofs.settings import dyn_settings
 from tests.helpers import EXAMPLES
 
 LIB = load_library()
@@ -34,7 +34,7 @@ def adder():
 
 
 def run(d, **kw):
-    st = DynSettings(violation_limit=0.005 * d.mechanism.ctx.stroke, **kw)
+    st = dyn_settings(d, **kw)
     return prove_dynamic(d, d.spec, LIB, st, extra=0, max_cases=CASES, prune=False)
 
 

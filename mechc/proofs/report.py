@@ -1,0 +1,148 @@
+"""The one report every proof engine returns, its JSON form and its text for the terminal.
+
+A report reads like its JSON (``report["cases"]``, ``report.get("failure_kinds")``), so code
+that looks at a proof's figures needs no engine-specific type; ``to_json()`` is the exact dict
+``mechc simulate --report`` writes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+
+from mechc.ui import table
+
+#: Coverage keys that come before "cases" in the JSON (the sequential kinematic walk's steps).
+BEFORE_CASES = ("steps",)
+#: Failures listed on the terminal (the report file has up to the engine's own limit).
+SHOWN_FAILURES = 10
+#: The figures of the logic level: positions, margins and joints are not defined there.
+LOGIC_FIGURES = {"max_position_error_fraction": None, "min_margin_fraction": None,
+                 "max_joint_violation_mm": None, "min_transmission_angle_deg": None}
+#: Summary table rows: JSON key, label (a row only where the report has a value).
+SUMMARY_KEYS = [
+    ("cases", "input states / changes"), ("transitions", "single-input changes"),
+    ("max_position_error_fraction", "max output error vs closed form (fraction of stroke)"),
+    ("max_deviation_fraction", "max output deviation from spec (fraction of stroke)"),
+    ("min_margin_fraction", "min margin to mid-stroke (fraction of stroke)"),
+    ("max_joint_violation_mm", "max joint violation (mm)"),
+    ("max_contact_penetration_mm", "max contact overrun (mm)"),
+    ("max_settle_time_s", "max settle time (s)"),
+    ("min_transmission_angle_deg", "min transmission angle (deg)"),
+    ("min_toggle_distance_deg", "min distance from toggle (deg)"),
+    ("seconds", "seconds"),
+]
+
+
+@dataclass(eq=False)
+class ProofReport(Mapping):
+    """What a proof checked, what failed, what it measured.
+
+    The JSON lists, in this order: passed, level, ``coverage`` (what was walked, around
+    "cases"), failure_count, failure_kinds and overlaps_by_cell (where the engine counts
+    them), failures, ``figures`` (the level's measurements), seconds, accuracy (when asked
+    for), and ``source`` (the files proved, set by the caller)."""
+
+    level: str  # logic | kinematic | dynamic
+    kind: str  # combinational | sequential (not in the JSON: the spec says which)
+    passed: bool
+    cases: int
+    failure_count: int
+    failures: list[dict]
+    seconds: float
+    coverage: dict = field(default_factory=dict)
+    failure_kinds: dict[str, int] | None = None
+    overlaps_by_cell: dict[str, int] | None = None
+    figures: dict = field(default_factory=dict)
+    accuracy: dict | None = None
+    source: dict = field(default_factory=dict)
+
+    def to_json(self) -> dict:
+        lead = {k: v for k, v in self.coverage.items() if k in BEFORE_CASES}
+        rest = {k: v for k, v in self.coverage.items() if k not in BEFORE_CASES}
+        out = {"passed": self.passed, "level": self.level, **lead, "cases": self.cases, **rest,
+               "failure_count": self.failure_count}
+        if self.failure_kinds is not None:
+            out["failure_kinds"] = self.failure_kinds
+        if self.overlaps_by_cell is not None:
+            out["overlaps_by_cell"] = self.overlaps_by_cell
+        out["failures"] = self.failures
+        out.update(self.figures)
+        out["seconds"] = self.seconds
+        if self.accuracy is not None:
+            out["accuracy"] = self.accuracy
+        out.update(self.source)
+        return out
+
+    def __getitem__(self, key: str):
+        return self.to_json()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_json())
+
+    def __len__(self) -> int:
+        return len(self.to_json())
+
+    def add_failure(self, kind: str, message: str) -> None:
+        """A failure found after the engine ran (a check on the run as a whole): listed first."""
+        self.passed = False
+        self.failure_count += 1
+        self.failure_kinds = {**(self.failure_kinds or {}), kind: 1}
+        self.failures.insert(0, {"kind": kind, "message": message})
+
+    def summary_text(self) -> str:
+        """The terminal's account: the figures, the verdict, the first failures and the
+        orderings a sequential circuit must respect."""
+        r = self.to_json()
+        rows = [[label, r[k]] for k, label in SUMMARY_KEYS if r.get(k) is not None]
+        lines = [table(rows, ["level " + self.level, "value"])]
+        if self.accuracy:
+            lines.append(accuracy_text(self.accuracy))
+        verdict = "PASSED" if self.passed else "FAILED"
+        kinds = self.failure_kinds
+        extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
+        lines.append(f"{verdict}: level {self.level}, {self.cases} cases, "
+                     f"{self.failure_count} failures{extra}, {self.seconds:.3f} s")
+        lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
+        if self.failure_count > SHOWN_FAILURES:
+            lines.append(f"  ... and {self.failure_count - SHOWN_FAILURES} more (see --report)")
+        hazards = (r.get("sequential") or {}).get("hazards") or []
+        if hazards:  # timing the logic cannot remove: what the mechanism must respect
+            lines.append(f"ordering requirements ({len(hazards)}; the kinematic and dynamic "
+                         "levels check them):")
+            lines += [f"  {h['kind']}: {h['requires']}" for h in hazards[:10]]
+        return "\n".join(lines)
+
+
+def failure_text(f: dict) -> str:
+    """One failure on one line, from whichever of its fields the engine filled in."""
+    if "message" in f and "inputs" not in f:
+        return f["message"]
+    ins = " ".join(f"{k}={v}" for k, v in f.get("inputs", {}).items())
+    kind = f.get("kind", "")
+    if kind in ("", "rest") and "got" in f:
+        return f"{f['output']}: expected {f['expected']}, got {f['got']} at {ins}"
+    head = f"{kind}: "
+    if "moving" in f:
+        head += f"{f['moving']} -> {f.get('to', '')} " if "to" in f else f"{f['moving']} moving "
+    if "output" in f:
+        head += f"output {f['output']} (expected {f['expected']}) "
+        for key in ("position", "max_deviation", "max_deviation_fraction", "deviation_fraction"):
+            if key in f:
+                head += f"{key.replace('_', ' ')} {f[key]} "
+    if "message" in f:
+        head += f["message"] + " "
+    return head + f"at {ins}"
+
+
+def accuracy_text(check: dict) -> str:
+    """Two lines for an accuracy-driven run: settings used, error obtained."""
+    c = check["chosen"]
+    verdict = "confirmed" if check["confirmed"] else "NOT confirmed"
+    return (f"accuracy {check['target_fraction']:g} of stroke: dt {c['dt_s']:g} s, "
+            f"{c['iterations']} iterations, move time {c['move_time_s']:g} s (model error "
+            f"{c['model_error_fraction']:.3g})\n"
+            f"  obtained {check['obtained_fraction']:.4g} (closed form "
+            f"{check['error_vs_closed_form_fraction']:.4g}, step halving "
+            f"{check['halving_estimate_fraction']:.4g} on {check['halving_cases']} changes): "
+            f"{verdict}")

@@ -1,0 +1,69 @@
+"""What a proof is asked to do (:class:`ProofSettings`) and the physics settings a dynamic
+proof runs at unless told otherwise (:func:`dyn_settings`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import networkx as nx
+
+from mechc.cells.library import Library
+from mechc.ir.design import Design
+from mechc.physics.scene import DynSettings
+
+#: A bilateral joint may stretch this share of the stroke before the proof calls it a solver
+#: error (0.1 mm at the default 20 mm stroke).
+VIOLATION_FRACTION = 0.005
+#: The stretch allowed when the design has no geometry to take a stroke from.
+VIOLATION_NO_GEOMETRY_MM = 0.1
+#: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
+MEMORY_THROW_S = 0.03
+
+
+@dataclass(frozen=True)
+class ProofSettings:
+    """The options of one proof; each engine reads the ones its level has."""
+
+    tolerance: float = 0.05  # outputs within this fraction of stroke of their positions
+    seed: int = 0  # for every random choice of cases
+    cases: int = 16  # dynamic, combinational: seeded random changes after the Gray tour
+    prune: bool = False  # dynamic, combinational: per-change pruned scenes requested
+    accuracy: float | None = None  # dynamic, combinational: the output error to choose for
+    dt: float | None = None  # dynamic: solver time step (s); None: DynSettings' default
+    iterations: int | None = None  # dynamic: solver iterations per step
+    move_time: float | None = None  # dynamic: seconds an input takes to move
+
+
+def dyn_settings(design: Design, lib: Library | None = None, dt: float | None = None,
+                 iterations: int | None = None, move_time: float | None = None) -> DynSettings:
+    """The physics settings a dynamic proof of ``design`` uses: joints may stretch
+    ``VIOLATION_FRACTION`` of its stroke; the solver options given replace the defaults. With
+    ``lib`` (the sequential proofs) each change is held at least the circuit's
+    :func:`settle_allowance`, so a circuit that is slow by design is not reported unsettled."""
+    mech = design.mechanism
+    st = DynSettings(violation_limit=VIOLATION_FRACTION * mech.ctx.stroke if mech
+                     else VIOLATION_NO_GEOMETRY_MM)
+    for name, value in (("dt", dt), ("iterations", iterations), ("move_time", move_time)):
+        if value is not None:
+            setattr(st, name, value)
+    if lib is not None:
+        st.settle_time = max(st.settle_time, settle_allowance(design, lib))
+    return st
+
+
+def settle_allowance(design: Design, lib: Library) -> float:
+    """How long after an input's move a sequential circuit may still be switching: along the
+    slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
+    transition may pass through every memory in turn. Used as the hold of each change (it
+    still must settle)."""
+    nl = design.netlist
+    g = nl.combinational_graph()
+    delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
+             for c in nl.cells.values()}
+    longest: dict[str, float] = {}
+    for node in nx.topological_sort(g):
+        here = max((longest[u] for u in g.predecessors(node)), default=0.0)
+        longest[node] = here + delay.get(node, 0.0)
+    path = max(longest.values(), default=0.0)
+    m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
+    return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
