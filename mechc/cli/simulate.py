@@ -1,0 +1,121 @@
+"""``mechc simulate``: prove a design (or a spec compiled in memory) at one level."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from mechc.backends.design_json import dumps, write_atomic
+from mechc.cells.library import Library, load_library
+from mechc.cli.common import check_output, compile_options, load_design_or_spec, load_spec
+from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mechc.ir.design import Design
+from mechc.ir.seqspec import SeqSpec
+from mechc.ir.spec import Spec
+from mechc.proofs import LEVELS, ProofReport, ProofSettings, prove, spec_kind
+from mechc.ui import Progress, finite_float
+
+
+def register(sub) -> None:
+    s = sub.add_parser("simulate", help="prove a design against its spec",
+                       formatter_class=argparse.RawDescriptionHelpFormatter,
+                       description="""\
+Prove a design: SPEC_OR_JSON is a compiled design (.json) or a spec, compiled in memory first.
+
+levels:
+  logic      the netlist's cells evaluated as Boolean functions on every input vector
+  kinematic  the mechanism's closed forms (from its geometry, not its logic types) on every
+             input vector at rest and sampled along every single-input change: outputs within
+             --tolerance of their positions, outputs that must not change dwell; design checks
+  dynamic    (default) pymunk rigid bodies, springs and contacts; inputs moved by bounded-force
+             actuators along a Gray-code tour of every vector plus --cases seeded random
+             changes; outputs at rest, glitches, settling, joint violations (solver error)
+
+Exit status 0 only if the proof holds; 1 if it fails (the failures are listed).""")
+    s.add_argument("design", metavar="SPEC_OR_JSON")
+    s.add_argument("--level", choices=list(LEVELS), default="dynamic",
+                   help="simulation level (default: %(default)s)")
+    s.add_argument("--tolerance", type=finite_float, default=0.05, metavar="F",
+                   help="outputs must sit within F of stroke of their position (default: "
+                   "%(default)s)")
+    s.add_argument("--cases", type=int, default=16, metavar="N",
+                   help="dynamic: seeded random single-input changes after the Gray tour "
+                   "(default: %(default)s)")
+    s.add_argument("--seed", type=int, default=0, help="seed for the random cases")
+    s.add_argument("--dt", type=finite_float, default=None, metavar="S",
+                   help="dynamic: time step in seconds (default 2.5e-4)")
+    s.add_argument("--iterations", type=int, default=None,
+                   help="dynamic: solver iterations per step (default 60)")
+    s.add_argument("--move-time", type=finite_float, default=None, metavar="S",
+                   help="dynamic: seconds an input takes to move (default 0.08)")
+    s.add_argument("--prune", action="store_true",
+                   help="dynamic: run each input change on a scene of only the cells it can "
+                   "move (see docs/performance.md)")
+    s.add_argument("--accuracy", type=finite_float, default=None, metavar="F",
+                   help="dynamic: the cheapest settings (from the measured error model) whose "
+                   "output error is at most F of stroke, confirmed on the run by step halving")
+    s.add_argument("--spec", metavar="OTHER",
+                   help="prove against this spec instead of the one the design was compiled from")
+    s.add_argument("--report", metavar="FILE.json", help="write the proof report as JSON")
+    compile_options(s)
+    s.set_defaults(func=run)
+
+
+SOLVER_OPTIONS = ("dt", "iterations", "move_time")
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    """Every option range, before any file is read or any proof started."""
+    if not 0 < args.tolerance < 0.5:
+        raise UsageError("--tolerance must be between 0 and 0.5")
+    if args.cases < 0:
+        raise UsageError("--cases must not be negative")
+    for opt in SOLVER_OPTIONS:
+        v = getattr(args, opt)
+        if v is not None and v <= 0:
+            raise UsageError(f"--{opt.replace('_', '-')} must be positive")
+    if args.accuracy is not None:
+        if not 0 < args.accuracy < 0.5:
+            raise UsageError("--accuracy must be between 0 and 0.5 (fraction of stroke)")
+        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
+            raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
+    if args.report:  # before a proof that may take minutes, not after it
+        check_output(args.report, "report", [("design", args.design), ("spec", args.spec)])
+
+
+def run(args: argparse.Namespace) -> int:
+    _check_options(args)
+    design = load_design_or_spec(args.design, args)
+    spec = load_spec(args.spec) if args.spec else design.spec
+    lib = load_library(args.cell_dirs)
+    try:
+        report = _prove(args, design, spec, lib)
+    except UsageError as e:  # the options were checked: this is about the design, name it
+        raise UsageError(f"{args.design}: {e}") from None
+    report.source = {"design": args.design, "spec": args.spec or design.spec.path}
+    print(report.summary_text())
+    if args.report:
+        write_atomic(args.report, dumps(report.to_json()))
+    return EXIT_OK if report.passed else EXIT_FAILED
+
+
+def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: Library
+           ) -> ProofReport:
+    """The proof at ``args.level`` of ``design`` against ``spec`` (a ProofReport), with a
+    progress bar while a dynamic proof runs."""
+    settings = ProofSettings(tolerance=args.tolerance, seed=args.seed, cases=args.cases,
+                             prune=args.prune, accuracy=args.accuracy, dt=args.dt,
+                             iterations=args.iterations, move_time=args.move_time)
+    if args.level != "dynamic":
+        return prove(design, spec, lib, args.level, settings)
+    what = "sequential dynamic" if spec_kind(spec) == "sequential" else "dynamic"
+    bar = Progress(1, f"{what} proof of {Path(args.design).name}")
+
+    def tick(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done, "input changes")
+
+    try:
+        return prove(design, spec, lib, args.level, settings, tick)
+    finally:
+        bar.close()
