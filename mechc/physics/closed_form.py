@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mechc.geometry.circles import circle_meeting
 from mechc.ir.mechanism import GROUND, Body, Joint, Part
 from mechc.parts import body_kind, joint_kind
 from mechc.parts.base import angle_between_lines, body_or_ground, cross, displacement, position
@@ -152,16 +153,14 @@ def _try_dyad(b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
         (A0, ax, ay, abad, _), (B0, bx, by, bbad, _) = mine, theirs
         r1 = float(np.hypot(P0[0] - A0[0], P0[1] - A0[1]))
         r2 = float(np.hypot(P0[0] - B0[0], P0[1] - B0[1]))
-        dx, dy = bx - ax, by - ay
-        d = np.hypot(dx, dy)
-        a = (r1 * r1 - r2 * r2 + d * d) / (2 * np.where(d > 0, d, 1.0))
-        h2 = r1 * r1 - a * a
-        ok = np.broadcast_to((h2 >= 0) & (d > 0), (size,))
-        h = np.sqrt(np.where(h2 >= 0, h2, 0.0))
+        # the pin is where the two circles meet, on the side it has at the design pose
         side = float(np.sign(cross((B0[0] - A0[0], B0[1] - A0[1]),
                                    (P0[0] - A0[0], P0[1] - A0[1])))) or 1.0
-        ex, ey = dx / np.where(d > 0, d, 1.0), dy / np.where(d > 0, d, 1.0)
-        px, py = ax + a * ex - side * h * ey, ay + a * ey + side * h * ex
+        centres_a = np.stack(np.broadcast_arrays(ax, ay), axis=-1)
+        centres_b = np.stack(np.broadcast_arrays(bx, by), axis=-1)
+        pin, h2 = circle_meeting(centres_a, r1, centres_b, r2, side, miss="clamp")
+        px, py = pin[..., 0], pin[..., 1]
+        ok = np.broadcast_to((h2 >= 0) & np.isfinite(h2), (size,))
         bad = ~ok
         for x in (abad, bbad):
             if x is not None:
