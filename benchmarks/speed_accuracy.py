@@ -4,7 +4,8 @@ against whole scenes, where the methods break, and peers (pylinkage, bare pymunk
     pip install -e '.[bench]'        # pylinkage (with numba), the peer; not a mechc dependency
     python benchmarks/speed_accuracy.py [--quick] [--out DIR] [--write-model [PATH]]
 
-The same as ``mechc bench``; the code is in ``mechc/bench/speed_accuracy.py``.
+The same as ``mechc bench``; the driver is ``mechc/bench/speed_accuracy.py``, one module per
+study beside it in ``mechc/bench/``.
 """
 
 from __future__ import annotations

@@ -1,0 +1,73 @@
+"""Peers in the same run: the kinematic level against pylinkage on one four-bar
+(:mod:`mechc.bench.fourbar`), and the dynamic level against a bare pymunk scene of the same
+bodies and joints.
+"""
+
+from __future__ import annotations
+
+from mechc.bench.circuits import Circuit
+from mechc.bench.fourbar import compare
+from mechc.bench.harness import Bench, clock, scene_types
+from mechc.physics.scene import Scene
+from mechc.proofs.settings import dyn_settings
+
+
+def peers(b: Bench, c: Circuit) -> None:
+    b.say("\n== peers in the same run ==")
+    try:
+        r = compare()
+    except ModuleNotFoundError as e:
+        b.say(f"pylinkage is not installed ({e}); pip install -e '.[bench]'")
+        b.summary["kinematic_vs_pylinkage"] = "n/a"
+    else:
+        fast = r.pylinkage_fast_per_s
+        best_peer = max(r.pylinkage_step_per_s, fast or 0.0)
+        b.say(f"four-bar: mechc closed form {r.mechc_per_s:,.0f} positions/s; pylinkage "
+              f"Linkage.step {r.pylinkage_step_per_s:,.0f}/s, step_fast ({r.pylinkage_backend}) "
+              f"{fast or float('nan'):,.0f}/s; rocker pins agree to "
+              f"{r.max_difference_mm:.1e} mm")
+        kernel = r.numba_kernel_per_s
+        b.say(f"floors on the same four-bar, positions only (no angle, transmission, flags or "
+              f"closure check): numpy {r.bare_numpy_per_s:,.0f}/s = "
+              f"{r.bare_numpy_per_s / best_peer:.2f}x pylinkage's best; compiled scalar loop "
+              + (f"{kernel:,.0f}/s = {kernel / best_peer:.2f}x" if kernel else "n/a (no numba)"))
+        b.summary["kinematic_vs_pylinkage"] = round(r.mechc_per_s / best_peer, 3)
+        b.summary["positions_only_numpy_vs_pylinkage"] = round(r.bare_numpy_per_s / best_peer, 3)
+        if kernel:
+            b.summary["positions_only_compiled_vs_pylinkage"] = round(kernel / best_peer, 3)
+        b.summary["kinematic_vs_pylinkage_step"] = round(r.mechc_per_s / r.pylinkage_step_per_s,
+                                                         2)
+        b.summary["pylinkage_backend"] = r.pylinkage_backend
+        b.summary["fourbar_positions_per_s"] = round(r.mechc_per_s)
+        for lvl, rate in (("mechc", r.mechc_per_s), ("pylinkage step", r.pylinkage_step_per_s),
+                          ("pylinkage step_fast", fast),
+                          ("positions only, numpy", r.bare_numpy_per_s),
+                          ("positions only, compiled", kernel)):
+            b.row(section="fourbar", circuit="four-bar", level=lvl, cases=r.positions,
+                  seconds=(r.positions / rate) if rate else "",
+                  error_fraction=r.max_difference_mm)
+    # dynamic level against a bare pymunk scene of the same bodies and joints
+    d = c.design
+    st = dyn_settings(d)
+    name = d.spec.inputs[0]
+    sc = Scene.build(d.mechanism, b.lib, scene_types(d), st, {k: 0.0 for k in d.spec.inputs})
+    t0 = clock()
+    r = sc.move(name, 1.0)
+    t_mechc = clock() - t0
+    bare = Scene.build(d.mechanism, b.lib, scene_types(d), st, {k: 0.0 for k in d.spec.inputs})
+    t0 = clock()
+    for _ in range(r.steps):
+        bare.space.step(st.dt)
+    t_bare = clock() - t0
+    joints = len(sc.space.constraints)
+    per_mechc = t_mechc / (r.steps * joints)
+    per_bare = t_bare / (r.steps * joints)
+    b.say(f"dynamic ({c.name}, {joints} constraints, {r.steps} steps): "
+          f"{per_mechc * 1e9:.0f} ns per joint-step with mechc's measuring and driving, "
+          f"{per_bare * 1e9:.0f} ns bare pymunk")
+    b.summary["dynamic_vs_bare_pymunk"] = round(per_mechc / per_bare, 3)
+    b.row(section="joint_step", circuit=c.name, level="dynamic", variant="mechc",
+          steps=r.steps, seconds=t_mechc)
+    b.row(section="joint_step", circuit=c.name, level="dynamic", variant="bare pymunk",
+          steps=r.steps, seconds=t_bare)
+
