@@ -12,6 +12,8 @@ from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
+import jsonschema
+
 from mechc import FORMAT_VERSION, __version__
 from mechc.errors import SpecError, UsageError
 from mechc.frontends.spec_json import seqspec_from_json, spec_from_json
@@ -124,8 +126,6 @@ def schema() -> dict:
 
 
 def validate(obj: dict, where: str) -> None:
-    import jsonschema
-
     v = jsonschema.Draft202012Validator(schema())
     errors = sorted(v.iter_errors(obj), key=lambda e: list(e.absolute_path))
     if errors:

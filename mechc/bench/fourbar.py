@@ -51,6 +51,7 @@ def mechc_rocker_pins(crank_angles: np.ndarray) -> np.ndarray:
 
 
 def pylinkage_linkage(steps_per_turn: int):
+    # pylinkage is the benchmark's optional peer (the bench extra), never a dependency
     from pylinkage.actuators import Crank
     from pylinkage.components import Ground
     from pylinkage.dyads import RRRDyad
@@ -97,6 +98,7 @@ def _numba_kernel():
     """The same positions-only closed form as a scalar loop compiled by numba (when numba is
     installed, as the benchmark extra installs it): what compiling, rather than vectorising,
     gives on this machine."""
+    # numba comes with the optional bench extra
     import numba
 
     part, b = mechc_part()
@@ -139,6 +141,7 @@ CHUNK = 4096
 def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResult:
     """Positions (rocker pin coordinates) per second of both on the same four-bar, CPU time,
     best of ``repeat``; and how far apart their rocker pins are."""
+    # the optional peer's compiled path (the bench extra)
     import pylinkage._numba_compat as nc
 
     th = np.linspace(0.0, 2 * math.pi, n, endpoint=False)

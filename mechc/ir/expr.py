@@ -96,6 +96,7 @@ def names(e: Expr) -> set[str]:
 
 def to_sympy(e: Expr, symbols: Mapping[str, object]):
     """The same expression in sympy (for equivalence checks and pretty printing)."""
+    # sympy takes half a second to load; only equivalence checks need it (start-up time)
     import sympy
 
     if isinstance(e, Var):

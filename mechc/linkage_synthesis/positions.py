@@ -24,6 +24,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from mechc.errors import SpecError, UsageError
 from mechc.linkage_synthesis.mk_circles import (
     ANGLE_NAMES,
@@ -124,8 +126,6 @@ def load_positions(path: str) -> ChainProblem:
 
 def format_positions(problem: ChainProblem, comment: str = "") -> str:
     """The problem as a positions file (inverse of :func:`parse_positions`)."""
-    import numpy as np
-
     names = list(ANGLE_NAMES[: problem.k])
     lines = [f"# {comment}"] if comment else []
     lines.append(f"free {ANGLE_NAMES[problem.free_link]}")

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+import networkx as nx
+
 from mechc.cells.library import Library
 from mechc.errors import DesignError
 from mechc.ir.netlist import CellInst, Netlist
@@ -136,8 +138,6 @@ def nets_short_of_force(nl: Netlist, mech, lib: Library) -> dict[str, str]:
 
 def _memories_reached(nl: Netlist) -> dict[str, tuple[str, ...]]:
     """Cell -> the MEMORY cells its output reaches through combinational logic (sorted)."""
-    import networkx as nx
-
     g = nl.combinational_graph()
     out = {}
     for cid in nl.cells:

@@ -13,6 +13,8 @@ on all fifteen numbers. ``python -m mechc.threshold.freebar`` prints the entry o
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 from scipy.optimize import minimize
 from scipy.stats import qmc
@@ -176,8 +178,6 @@ def search_free(canonical: tuple[int, ...], mu_min_deg: float = 45.0, seed: int 
 
 
 def main() -> None:
-    import time
-
     canonical = (0, 0, 0, 1, 1, 0, 1, 1)  # the multiplexer class (FV 27)
     t0 = time.perf_counter()
     found = search_free(canonical)
