@@ -18,7 +18,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from mechc.linkage_synthesis import mk_circles as mk
-from mechc.linkage_synthesis import three_bar as tb
+from mechc.linkage_synthesis import three_bar_gate as tb
 
 
 def random_problem(rng, k, n, free_link, known):

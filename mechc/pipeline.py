@@ -20,7 +20,7 @@ from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
 from mechc.passes.amplify import amplify_nets, nets_short_of_force, snap_outputs
-from mechc.passes.assemble import MechOptions, synthesise_mechanism
+from mechc.passes.assemble import MechOptions, assemble_mechanism
 from mechc.passes.checks import run_design_checks
 from mechc.passes.flowtable import SynthOptions, derive_equations, synthesise_table
 from mechc.passes.map import MapOptions, map_equations, map_sequential
@@ -59,7 +59,7 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
     eq = stage("minimise", minimise, spec, opts.minimise)
     mapped = stage("map", map_equations, eq, lib, opts.map)
     layout = stage("place", place, mapped.netlist)
-    nl, layout, mech, amps = stage("synthesise", synthesise_powered, mapped.netlist, lib, opts,
+    nl, layout, mech, amps = stage("assemble", assemble_powered, mapped.netlist, lib, opts,
                                    layout)
     stats = design_stats(eq, nl, lib, layout)
     if amps:
@@ -130,7 +130,7 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
         equations[se.reset_names[m]] = se.text(se.reset_names[m])
     mech = None
     if mechanism:
-        nl, layout, mech, more = stage("synthesise", synthesise_powered, nl, lib, opts, layout)
+        nl, layout, mech, more = stage("assemble", assemble_powered, nl, lib, opts, layout)
         amps.update(more)
     stats = design_stats(se.eq, nl, lib, layout)
     stats["sequential"] = {"memories": len(se.memories), **se.checked}
@@ -147,7 +147,7 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
 MAX_AMPLIFY_ROUNDS = 3
 
 
-def synthesise_powered(nl: Netlist, lib: Library, opts: CompileOptions,
+def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
                        layout: Layout | None = None
                        ) -> tuple[Netlist, Layout, Mechanism, dict[str, str]]:
     """Place and synthesise; where the force budget fails (an input actuator overloaded, a
@@ -158,7 +158,7 @@ def synthesise_powered(nl: Netlist, lib: Library, opts: CompileOptions,
     for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
         if layout is None or attempt:
             layout = place(nl)
-        mech = synthesise_mechanism(nl, layout, lib, opts.mech)
+        mech = assemble_mechanism(nl, layout, lib, opts.mech)
         if not opts.amplify or attempt == MAX_AMPLIFY_ROUNDS:
             break
         short = nets_short_of_force(nl, mech, lib)
@@ -177,7 +177,7 @@ def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = 
     lib = library or load_library(opts.cell_dirs)
     netlist.check()
     layout = place(netlist)
-    mech = synthesise_mechanism(netlist, layout, lib, opts.mech)
+    mech = assemble_mechanism(netlist, layout, lib, opts.mech)
     stats = {"cells": len(netlist.cells), "cells_by_type": netlist.count_by_type()}
     design = Design(spec, {}, {}, netlist, layout, stats, {}, None, mech)
     run_design_checks(design, lib)

@@ -2,10 +2,11 @@
 
 Two input links, one from each input slider, meet at a middle joint M; an output link joins M to
 the output slider on the axis between them. The lengths come from
-:mod:`mechc.linkage_synthesis.three_bar` (closed form, confirmed numerically), so the output sits
-at the same place for FF, FT and TF and moves one full stroke for TT: an AND gate. Mirrored left to
-right, "false" and "true" swap at every terminal and the same linkage is an OR gate (the blog's
-"the linkages are just reversed"), with every terminal still moving +x from off to on.
+:mod:`mechc.linkage_synthesis.three_bar_gate` (closed form, confirmed numerically), so the
+output sits at the same place for FF, FT and TF and moves one full stroke for TT: an AND gate.
+Mirrored left to right, "false" and "true" swap at every terminal and the same linkage is an OR
+gate (the blog's "the linkages are just reversed"), with every terminal still moving +x from off
+to on.
 
 The gate is bilateral: no spring and no one-sided contact, the links drive the output both ways
 and the output's load comes back on *both* inputs, including the one standing still. Its input
@@ -45,7 +46,7 @@ from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.errors import DesignError
 from mechc.ir.mechanism import Body, Demand, Joint, Point, SynthContext
-from mechc.linkage_synthesis import three_bar as tb
+from mechc.linkage_synthesis import three_bar_gate as tb
 
 # Geometry as fractions of the stroke (the gate scales exactly). Chosen from a scan of healthy
 # designs (transmission >= 45 deg, link ratio >= 1/3): the least inward wander whose outward

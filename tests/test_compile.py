@@ -195,7 +195,7 @@ def test_timings_only_on_request(cli, tmp_path):
     out = tmp_path / "t.json"
     cli("compile", EXAMPLES / "sorter.bool", "-o", out, "--timings")
     secs = json.loads(out.read_text())["stats"]["seconds"]
-    assert set(secs) == {"minimise", "map", "place", "synthesise", "check"}
+    assert set(secs) == {"minimise", "map", "place", "assemble", "check"}
     assert secs["minimise"] > 0 and secs["check"] > 0  # measured, not placeholders
     plain = tmp_path / "p.json"
     cli("compile", EXAMPLES / "sorter.bool", "-o", plain)

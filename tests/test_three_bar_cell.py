@@ -26,7 +26,7 @@ from mechc.errors import DesignError, UsageError
 from mechc.frontends.boolfile import parse_bool
 from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
-from mechc.linkage_synthesis import three_bar as tb
+from mechc.linkage_synthesis import three_bar_gate as tb
 from mechc.physics.closed_form import position, solve
 from mechc.pipeline import compile_netlist
 from mechc.proofs.dynamic import prove_dynamic

@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
-from mechc.linkage_synthesis import three_bar as tb
+from mechc.linkage_synthesis import three_bar_gate as tb
 from mechc.linkage_synthesis.adders import LongBarAdder, bar_shortening, long_bar_adder
 from mechc.linkage_synthesis.defects import check_dyads
 from mechc.linkage_synthesis.examples import EXAMPLES

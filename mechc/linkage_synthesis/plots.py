@@ -11,7 +11,7 @@ from pathlib import Path
 import matplotlib
 
 from mechc.linkage_synthesis.mk_circles import PIVOT_NAMES, pole
-from mechc.linkage_synthesis.three_bar import STATES, kinematics
+from mechc.linkage_synthesis.three_bar_gate import STATES, kinematics
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402

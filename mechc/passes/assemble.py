@@ -30,7 +30,7 @@ class MechOptions:
     output_load: float = 0.5  # N, what each circuit output must move, either way
 
 
-def synthesise_mechanism(nl: Netlist, layout: Layout, lib: Library,
+def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                          opts: MechOptions | None = None) -> Mechanism:
     opts = opts or MechOptions()
     ctx = SynthContext(stroke=opts.stroke)

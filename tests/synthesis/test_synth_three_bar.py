@@ -2,7 +2,7 @@
 
 The independent reference is a least-squares loop closure (scipy) continued step by step from
 the FF state -- the branch the mechanism really moves along -- sharing no formula with
-mechc.linkage_synthesis.three_bar.
+mechc.linkage_synthesis.three_bar_gate.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.optimize import least_squares
 
-from mechc.linkage_synthesis import three_bar as tb
+from mechc.linkage_synthesis import three_bar_gate as tb
 
 
 def loop_closure(d: tb.ThreeBarDesign, path_a, path_b):
