@@ -222,3 +222,22 @@ def test_output_to_a_device_is_written_not_replaced(cli, tmp_path):
     assert code == 0, err
     assert stat.S_ISFIFO(os.stat(fifo).st_mode)  # still a pipe, not replaced by a file
     assert '"format": "mechc"' in got[0]
+
+
+def test_compile_never_writes_a_design_simulate_refuses(cli, tmp_path):
+    """An absurd output load makes numbers no reader accepts: compile refuses (exit 2), names
+    the options, writes nothing, and leaves an existing file as it was."""
+    out = tmp_path / "s.json"
+    out.write_text("keep me")
+    rc, _, err = cli("compile", EXAMPLES / "sorter.bool", "-o", out, "--output-load", "1e8")
+    assert rc == 2
+    assert "refusing to write" in err and "--output-load 1e+08 N" in err
+    assert out.read_text() == "keep me"
+
+
+def test_unreadable_spec_paths_have_no_line_and_column(cli, tmp_path):
+    rc, _, err = cli("compile", tmp_path)
+    assert rc == 2 and f"{tmp_path}: is a directory, expected a spec file" in err
+    rc, _, err = cli("compile", tmp_path / "missing.bool")
+    assert rc == 2 and f"{tmp_path / 'missing.bool'}: file not found" in err
+    assert ":1:1:" not in err

@@ -167,10 +167,17 @@ def load_design_json(path: str | Path) -> dict:
     if obj.get("version") != FORMAT_VERSION:
         raise UsageError(f"{p}: design format version {obj.get('version')} is not supported "
                          f"(this mechc reads version {FORMAT_VERSION}); recompile the spec")
-    check_numbers(obj, str(p))
-    validate(obj, str(p))
-    check_references(obj, str(p))
+    check_design(obj, str(p))
     return obj
+
+
+def check_design(obj: dict, where: str) -> None:
+    """Everything reading a design checks before any work on it: numbers in range, the schema,
+    the references the schema cannot express. Compile runs it too, so it never writes a file
+    that ``simulate`` or ``draw`` would then refuse."""
+    check_numbers(obj, where)
+    validate(obj, where)
+    check_references(obj, where)
 
 
 def check_numbers(obj, where: str) -> None:

@@ -7,18 +7,25 @@ import sys
 import time
 from pathlib import Path
 
-from mechc.backends.design_json import design_to_json, dumps, validate, write_atomic
+from mechc.backends.design_json import (
+    check_design,
+    design_to_json,
+    dumps,
+    write_atomic,
+)
 from mechc.cli.common import by_type, check_output, compile_options, compile_path
-from mechc.errors import EXIT_FAILED, EXIT_OK
+from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mechc.frontends import SPEC_SUFFIXES
 
 
 def register(sub) -> None:
     c = sub.add_parser("compile", help="compile a spec to a netlist JSON",
-                       description="Parse SPEC (.bool or .pla), minimise every output exactly, "
-                       "map to library cells, place them, and write the design as JSON. The "
+                       description="Parse SPEC (" + ", ".join(SPEC_SUFFIXES) + "), minimise "
+                       "every output exactly (or synthesise a flow table), map to library cells, "
+                       "place and dimension them, check the design, and write it as JSON. The "
                        "output file is written atomically: on any error an existing file is "
                        "left untouched.")
-    c.add_argument("spec", help="specification file (.bool, .pla, .fsm)")
+    c.add_argument("spec", help="specification file (" + ", ".join(SPEC_SUFFIXES) + ")")
     c.add_argument("-o", "--output", help="output JSON file (default: SPEC with .json suffix)")
     compile_options(c)
     c.add_argument("--timings", action="store_true",
@@ -35,7 +42,13 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     design = compile_path(args.spec, args)
     obj = design_to_json(design, timings=args.timings)
-    validate(obj, out)
+    try:  # the same checks simulate and draw make on reading it, before anything is written
+        check_design(obj, out)
+    except UsageError as e:
+        raise UsageError(f"refusing to write {out}: {str(e).removeprefix(out + ': ')} (the "
+                         f"options asked for more than a design can carry: --output-load "
+                         f"{args.output_load:g} N, --actuator-force {args.actuator_force:g} N, "
+                         f"--stroke {args.stroke:g} mm)") from None
     write_atomic(out, dumps(obj))
     st = design.stats
     methods = {v["method"] for v in st["minimisation"]["outputs"].values()}

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from mechc.errors import SpecError
+from mechc.errors import SpecError, UsageError
 from mechc.frontends.blif import parse_blif_file
 from mechc.frontends.boolfile import parse_bool_file
 from mechc.frontends.fsm import parse_fsm_file
@@ -32,6 +32,9 @@ SPEC_SUFFIXES = tuple(FRONT_ENDS)
 def load_spec(path: str | Path) -> Spec | SeqSpec:
     """Parse a spec file, choosing the front end by suffix."""
     p = Path(path)
+    if p.is_dir():
+        raise UsageError(f"{p}: is a directory, expected a spec file "
+                         f"({', '.join(SPEC_SUFFIXES)})")
     suffix = p.suffix.lower()
     if suffix in FRONT_ENDS:
         return FRONT_ENDS[suffix](str(p))

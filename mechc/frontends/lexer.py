@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from mechc.errors import SpecError
+from mechc.errors import SpecError, UsageError
 
 MAX_SPEC_BYTES = 50_000_000
 #: Longest name or number: real ones are a few characters (a column label has one digit per
@@ -53,12 +53,13 @@ def read_text(path: str | Path) -> str:
     p = Path(path)
     try:
         data = p.read_bytes()
+    # a file that cannot be read has no line or column to point at
     except FileNotFoundError:
-        raise SpecError(str(path), 1, 1, "file not found") from None
+        raise UsageError(f"{path}: file not found") from None
     except IsADirectoryError:
-        raise SpecError(str(path), 1, 1, "is a directory, expected a spec file") from None
+        raise UsageError(f"{path}: is a directory, expected a spec file") from None
     except OSError as e:
-        raise SpecError(str(path), 1, 1, f"cannot read file: {e.strerror}") from None
+        raise UsageError(f"{path}: cannot read file: {e.strerror}") from None
     if len(data) > MAX_SPEC_BYTES:
         raise SpecError(str(path), 1, 1, f"file is {len(data)} bytes; the limit is "
                         f"{MAX_SPEC_BYTES}")
