@@ -80,3 +80,14 @@ def test_default_dyn_settings(sorter, toggle):
     assert dyn_settings(toggle).violation_limit == 0.1  # no geometry: no stroke to scale by
     slow = dyn_settings(toggle, LIB)
     assert slow.settle_time == max(0.15, settle_allowance(toggle, LIB)) > 0.15
+
+
+def test_a_sampled_proof_says_so_in_its_verdict():
+    def report(exhaustive: bool) -> ProofReport:
+        return ProofReport(level="kinematic", kind="combinational", passed=True, cases=512,
+                           failure_count=0, failures=[], seconds=0.1,
+                           coverage={"exhaustive": exhaustive})
+
+    assert "512 sampled cases (not exhaustive)" in report(False).summary_text()
+    assert "512 cases," in report(True).summary_text()
+    assert "sampled" not in report(True).summary_text()

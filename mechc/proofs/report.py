@@ -101,7 +101,10 @@ class ProofReport(Mapping):
         verdict = "PASSED" if self.passed else "FAILED"
         kinds = self.failure_kinds
         extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
-        lines.append(f"{verdict}: level {self.level}, {self.cases} cases, "
+        # a sampled proof says so where the verdict is read, not only in --report
+        cases = (f"{self.cases} sampled cases (not exhaustive)"
+                 if self.coverage.get("exhaustive") is False else f"{self.cases} cases")
+        lines.append(f"{verdict}: level {self.level}, {cases}, "
                      f"{self.failure_count} failures{extra}, {self.seconds:.3f} s")
         lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
         if self.failure_count > SHOWN_FAILURES:
