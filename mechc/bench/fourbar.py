@@ -133,7 +133,7 @@ class PeerResult:
 
 
 # states per vectorised call, cache-sized. A proof's sweep chunks larger (budget // (3 bodies),
-# mechc/sim/kinematic.py); for this two-lever part 16384 measured ~25% faster and 65536 slower
+# mechc/proofs/kinematic.py); for this two-lever part 16384 measured ~25% faster and 65536 slower
 # (memory-bound), so 4096 is neither the best nor the worst case.
 CHUNK = 4096
 
