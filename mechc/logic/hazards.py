@@ -1,10 +1,10 @@
 """Static-1 hazard removal: add consensus terms so one product covers every single-input change.
 
-In a linkage an OR bar's position is the max of its inputs and an AND bar's the min, so the
-sum of products a·b + ā·c, with b = c = 1 while a moves, dips to half stroke mid-motion: the
-mechanical form of a static-1 hazard (DESIGN §3: outputs must dwell). A cover is free of it when
-every pair of adjacent care-1 minterms (differing in one input) lies inside a single cube; the
-cheapest primes that cover the pairs the minimum cover misses are added (exact integer program
+In a linkage an OR bar's position is the max of its inputs and an AND bar's the min, so the sum of
+products a·b + ā·c, with b = c = 1 while a moves, dips to half stroke mid-motion: the mechanical
+form of a static-1 hazard (outputs must dwell: docs/mechanism.md). A cover is free of it when every
+pair of adjacent care-1 minterms (differing in one input) lies inside a single cube; the cheapest
+primes that cover the pairs the minimum cover misses are added (exact integer program
 with a time limit, greedy fallback).
 """
 

@@ -1,14 +1,15 @@
-"""The design-check pass (DESIGN §7): every check of a synthesised mechanism is made here.
+"""The design-check pass (docs/mechanism.md, "Design checks"): every check of a synthesised
+mechanism is made here.
 
-Each check is a number with a limit, so a failure says by how much. In the order the design
-lists them: the force checks decided when the mechanism was sized (each input actuator's rating
-against what its net needs, a force budget that would not converge), each placed cell's own
-rules (``Cell.checks``), then what the kinematic samples of the whole mechanism measure: minimum
+Each check is a number with a limit, so a failure says by how much. In the order the design lists
+them: the force checks decided when the mechanism was sized (each input actuator's rating against
+what its net needs, a force budget that would not converge), each placed cell's own rules
+(``Cell.checks``), then what the kinematic samples of the whole mechanism measure: minimum
 transmission angle over every sampled state (rest and along single-input motions), distance from
 singular (toggle) configurations, states the closed forms could not solve (parts that cannot
-assemble, a pin off the end of its slot, a slider jammed between contradictory limits), spring
-force at its weakest against what it must move, and for a sequential design each MEMORY's SET
-and RESET never pressing together.
+assemble, a pin off the end of its slot, a slider jammed between contradictory limits), spring force
+at its weakest against what it must move, and for a sequential design each MEMORY's SET and RESET
+never pressing together.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Scene pruning: per input change, only the part of the mechanism that can move the outputs.
 
-DESIGN §5 "model no more than a scene needs". For one input change the closed form says which
-bodies move along the way (41 samples of the moving input, as ``Scene.move`` samples it). The
-dynamic scene then holds:
+The rule that a simulation models no more than its question needs. For one input change the closed
+form says which bodies move along the way (41 samples of the moving input, as ``Scene.move`` samples
+it). The dynamic scene then holds:
 
 - **cells** — the fan-in cone of the observed outputs, restricted to cells with an input that
   moves, the walk not passing an AMPLIFIER's inputs (an amplifier's powered output isolates
@@ -28,11 +28,11 @@ keeps still (it *dwells*) but that drives cells outside the scene must really st
 otherwise a dynamic glitch would travel on into cells that were cut away. Those outputs are
 watched during the move (:data:`WATCH_PREFIX` pseudo-outputs); if one leaves ``watch_limit``
 (fraction of stroke) the case is run again on the whole mechanism (counted as ``escalated``).
-Un-moving upstream cells and still bodies are held exactly at their closed-form positions:
-whether their springs really hold against the kept cells' loads is the static force-budget
-check's job (spring margin, DESIGN §7), which runs in every proof. A static body is stiffer than
-a sprung one: the largest joint stretch of a frozen scene came out larger than the whole
-scene's on every benchmark circuit (docs/performance.md), so the stretch limit is not eased.
+Un-moving upstream cells and still bodies are held exactly at their closed-form positions: whether
+their springs really hold against the kept cells' loads is the static force-budget check's job
+(spring margin, a design check), which runs in every proof. A static body is stiffer than a sprung
+one: the largest joint stretch of a frozen scene came out larger than the whole scene's on every
+benchmark circuit (docs/performance.md), so the stretch limit is not eased.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""Where the methods break, mechc says so (DESIGN §5): each test drives a method past its limit
-and asserts the specific failure the proof reports, next to a control run that passes — so a
+"""Where the methods break, mechc says so (docs/performance.md): each test drives a method past its
+limit and asserts the specific failure the proof reports, next to a control run that passes — so a
 test fails both if the detection is removed and if it fires on a sound run.
 
 Where each breaks is measured by ``benchmarks/speed_accuracy.py`` (stability.png); the cases

@@ -21,7 +21,7 @@ from mechc.threshold.weights import realise, static_hazards
 
 STROKE = 20.0
 SAMPLES = 50
-MARGIN = 0.05  # of stroke (DESIGN.md §3)
+MARGIN = 0.05  # of stroke (the proofs' margin, docs/mechanism.md)
 X = input_matrix(3)
 
 # Minimum thresholds per NPN class from 001 Table II (Mow and Fu): class representative FV -> k.

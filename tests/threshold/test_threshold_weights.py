@@ -110,7 +110,7 @@ def test_realisation_conventions():
 
 
 def test_full_adder_sum_vector_from_design_notes():
-    # DESIGN.md §10 / 001 §3.8.2: W;T = (-1, 1, 1; 1.5, 0.5, -0.5) realises FV 105, and no
+    # 001 §3.8.2: W;T = (-1, 1, 1; 1.5, 0.5, -0.5) realises FV 105, and no
     # realisation needs fewer thresholds or a smaller sum of |w|.
     tt = truth_table_from_fv(105)
     th, below = thresholds_for((-1, 1, 1), tt)
