@@ -2,7 +2,7 @@
 
     python benchmarks/flowtable.py [--sizes 4 8 12 16 24 32] [--tables 2] [--inputs 2] [--seed 0]
 
-Tables come from ``mechc.ir.seqspec.random_flow_table`` (seeded): each row stable in one
+Tables come from ``mechc.bench.circuits.random_flow_table`` (seeded): each row stable in one
 column, each single-input change from it specified with probability 0.8 towards a random row
 stable in the new column, two outputs. Per table the stages are timed in this process:
 implication table + minimum closed cover, state assignment, and the equations (excitation,
@@ -22,7 +22,8 @@ import time
 
 import numpy as np
 
-from mechc.ir.seqspec import SeqSpec, random_flow_table
+from mechc.bench.circuits import random_flow_table
+from mechc.ir.seqspec import SeqSpec
 from mechc.passes.flowtable import (
     assign_states,
     brute_force_min_cover,

@@ -20,6 +20,7 @@ from mechc.frontends import load_spec
 from mechc.frontends.fsm import parse_fsm_file
 from mechc.ir.design import Design
 from mechc.ir.netlist import CellInst, Netlist
+from mechc.ir.seqspec import FlowTable
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube, input_matrix
 from mechc.passes.assemble import MechOptions
@@ -150,3 +151,29 @@ def bench_circuits(quick: bool, say: Callable[[str], None]) -> list[Circuit]:
         out.append(Circuit(f"random{cells}", d, cases, note))
     return out
 
+
+def random_flow_table(rng: np.random.Generator, rows: int, inputs: int = 2, outputs: int = 1,
+                      p_entry: float = 0.8) -> FlowTable:
+    """A random valid primitive flow table (benchmarks and property tests): each row stable
+    in one column (every column used while rows last), each single-input change from it
+    specified with probability ``p_entry`` towards a random row stable in the new column."""
+    ncol = 1 << inputs
+    cols = [i ^ (i >> 1) for i in range(ncol)]  # Gray order, as tables are written
+    home = [r % ncol if r < ncol else int(rng.integers(ncol)) for r in range(rows)]
+    home = [int(h) for h in rng.permutation(home)] if rows <= ncol else home
+    by_col: dict[int, list[int]] = {}
+    for r, k in enumerate(home):
+        by_col.setdefault(k, []).append(r)
+    nxt: list[list[int | None]] = []
+    for r in range(rows):
+        line: list[int | None] = [None] * ncol
+        line[home[r]] = r
+        for b in range(inputs):
+            k2 = cols.index(cols[home[r]] ^ (1 << b))
+            if by_col.get(k2) and rng.random() < p_entry:
+                line[k2] = int(rng.choice(by_col[k2]))
+        nxt.append(line)
+    out = [[int(v) for v in rng.integers(0, 2, size=outputs)] for _ in range(rows)]
+    names = [f"s{r + 1}" for r in range(rows)]
+    return FlowTable([f"x{i + 1}" for i in range(inputs)], [f"z{j + 1}" for j in range(outputs)],
+                     cols, names, nxt, out, 0, None, [0] * rows)

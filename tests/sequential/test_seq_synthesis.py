@@ -7,9 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from mechc.bench.circuits import random_flow_table
 from mechc.errors import DesignError
 from mechc.frontends.fsm import parse_fsm, parse_fsm_file
-from mechc.ir.seqspec import SeqSpec, SequentialError, random_flow_table
+from mechc.ir.seqspec import SeqSpec, SequentialError
 from mechc.passes.flowtable import (
     assign_states,
     closed_cover,
