@@ -185,8 +185,13 @@ def test_user_cell_directory_is_picked_up_without_compiler_edits(cli, tmp_path):
     design = tmp_path / "d.json"
     spec = tmp_path / "s.bool"
     spec.write_text("inputs a b\noutputs z\nz = a & b\n")
-    assert cli("compile", spec, "-o", design, "--cells", tmp_path)[0] == 0
+    code, out, _ = cli("compile", spec, "-o", design, "--cells", tmp_path)
+    assert code == 0
     assert json.loads(design.read_text())["cells"][0]["cell"] == "cheap_and"
+    # the summary says which cell was used, and that it stands in for the standard one
+    assert "cells used: AND cheap_and" in out
+    assert f"user cell cheap_and ({tmp_path / 'my_and.py'}) for AND, instead of the standard " \
+        "and" in out
 
 
 def test_user_cell_without_mechanism_is_a_clear_error(cli, tmp_path):

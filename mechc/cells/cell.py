@@ -53,6 +53,7 @@ class Cell:
     pin_kind: ClassVar[str] = "translating"
     description: ClassVar[str] = ""
     source: ClassVar[str] = ""  # set by the library loader: file the cell came from
+    standard: ClassVar[bool] = False  # set by the loader: True for the cells of stdlib/
     auto_select: ClassVar[bool] = True  # offered to the mapper by cost (else only on request)
     stateful: ClassVar[bool] = False  # kinematics needs the previous state (MEMORY)
 

@@ -55,6 +55,10 @@ class Library:
                 best = (key, cell)
         return best[1] if best else None
 
+    def standard_cells(self, type_name: str) -> list[str]:
+        """The standard library's cells of a logic type (what a user cell may stand in for)."""
+        return [n for n, c in self.cells.items() if c.type == type_name and c.standard]
+
     def max_fan_in(self, type_name: str) -> int:
         return max((c.max_inputs for c in self.cells.values() if c.type == type_name), default=0)
 
@@ -83,7 +87,7 @@ def load_library(extra_dirs: Iterable[str] = ()) -> Library:
             continue
         path = Path(std[0]) / f"{info.name}.py"
         mod = _guarded(path, lambda name=info.name: importlib.import_module(f"{STDLIB}.{name}"))
-        _collect(mod, path, found)
+        _collect(mod, path, found, standard=True)
     for d in dirs:
         p = Path(d)
         if not p.is_dir():
@@ -94,7 +98,7 @@ def load_library(extra_dirs: Iterable[str] = ()) -> Library:
             if f.name.startswith("_"):
                 continue
             mod = _guarded(f, lambda f=f: _import_file(f))
-            _collect(mod, f, found)
+            _collect(mod, f, found, standard=False)
     lib = Library(found)
     _CACHE[dirs] = lib
     return lib
@@ -120,7 +124,7 @@ def _guarded(path: Path, load):
                          f"{type(e).__name__}: {e}") from None
 
 
-def _collect(mod, path: Path, found: dict[str, type[Cell]]) -> None:
+def _collect(mod, path: Path, found: dict[str, type[Cell]], standard: bool) -> None:
     for _n, obj in inspect.getmembers(mod, inspect.isclass):
         if not issubclass(obj, Cell) or obj is Cell or obj.__module__ != mod.__name__:
             continue
@@ -133,4 +137,5 @@ def _collect(mod, path: Path, found: dict[str, type[Cell]]) -> None:
             raise UsageError(f"{path}: cell name '{obj.name}' is already defined in "
                              f"{found[obj.name].source}")
         obj.source = str(path)
+        obj.standard = standard
         found[obj.name] = obj

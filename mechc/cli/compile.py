@@ -13,9 +13,11 @@ from mechc.backends.design_json import (
     dumps,
     write_atomic,
 )
+from mechc.cells.library import Library, load_library
 from mechc.cli.common import by_type, check_output, compile_options, compile_path
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 from mechc.frontends import SPEC_SUFFIXES
+from mechc.ir.design import Design
 
 
 def register(sub) -> None:
@@ -77,6 +79,8 @@ def run(args: argparse.Namespace) -> int:
         for h in se.essential_hazards:
             print(f"  essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
                   f"{h['to']}: {h['requires']}")
+    for line in cells_used(design, load_library(args.cell_dirs)):
+        print(f"  {line}")
     for net, why in st.get("amplified", {}).items():
         print(f"  AMPLIFIER on {net}: {why}")
     if args.print_netlist:
@@ -92,3 +96,22 @@ def run(args: argparse.Namespace) -> int:
         print(f"  design checks: {dc['count']} passed (min transmission angle "
               f"{dc['min_transmission_angle_deg']}°)")
     return EXIT_OK
+
+
+def cells_used(design: Design, lib: Library) -> list[str]:
+    """Which library cell realises each logic type, and every user cell the mapper chose (with
+    its file, and the standard cells it stands in for), so a user cell never replaces a
+    standard one unannounced."""
+    names: dict[str, set[str]] = {}
+    for c in design.netlist.cells.values():
+        names.setdefault(c.type, set()).add(c.cell)
+    lines = ["cells used: " + ", ".join(f"{t} {'/'.join(sorted(n))}"
+                                        for t, n in sorted(names.items()))]
+    for name in sorted(set().union(*names.values()) if names else ()):
+        cls = lib[name]
+        if cls.standard:
+            continue
+        std = [s for s in lib.standard_cells(cls.type) if s != name]
+        lines.append(f"user cell {name} ({cls.source}) for {cls.type}"
+                     + (f", instead of the standard {', '.join(std)}" if std else ""))
+    return lines
