@@ -9,7 +9,7 @@ Forces are newtons, rates N/mm, masses kg.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 
 from mechc.ir.check import Check
 
@@ -216,14 +216,6 @@ class Part:
             if b.id == bid:
                 return b
         raise KeyError(bid)
-
-
-def check_list_json(checks: list[Check]) -> list[dict]:
-    return [c.to_json() for c in checks]
-
-
-def asjson(obj) -> dict:
-    return asdict(obj)
 
 
 @dataclass(frozen=True)

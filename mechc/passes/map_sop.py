@@ -18,7 +18,6 @@ from mechc.ir import expr as ex
 from mechc.ir.equations import Cover, Equations
 from mechc.ir.logic_types import TYPES
 from mechc.ir.netlist import CellInst, Netlist
-from mechc.logic.cubes import Cube
 
 Key = tuple  # ("in", name) | ("CONST", value) | (TYPE, (child keys...))
 
@@ -263,9 +262,3 @@ def _materialise(roots: dict[str, Key], eq: Equations, library: Library,
         nl.set_output(name, build(key))
     nl.check()
     return nl
-
-
-def cube_key(cube: Cube) -> tuple[int, int]:
-    return (cube.mask, cube.value)
-
-

@@ -92,12 +92,6 @@ class CheckStats:
         return out
 
 
-def kinematic_checks(mech: Mechanism, poses: Poses) -> list[Check]:
-    stats = CheckStats(mech)
-    stats.add(poses)
-    return stats.checks()
-
-
 def _where(jid: str) -> str:
     """Report checks per cell (``c3``), per net (``net n1``) or per input (``input A``)."""
     if jid.startswith("net."):

@@ -5,10 +5,6 @@ from __future__ import annotations
 import numpy as np
 
 
-def all_vectors(n: int) -> np.ndarray:
-    return np.arange(1 << n, dtype=np.int64)
-
-
 def bits(rows: np.ndarray, n: int) -> np.ndarray:
     """(n, len(rows)) 0/1 matrix, input 0 the most significant bit."""
     shifts = np.arange(n - 1, -1, -1, dtype=np.int64)[:, None]

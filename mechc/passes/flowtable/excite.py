@@ -27,13 +27,6 @@ def subcube(a: int, b: int) -> list[int]:
     return out
 
 
-@dataclass
-class Transition:
-    column: int
-    source: int  # class
-    dest: int  # class
-
-
 def next_state_map(rt: ReducedTable, asg: Assignment) -> list[dict[int, int]]:
     """Per column: code -> destination class, over every code a transition may pass through.
     Two transitions of a column that could meet on a code, or a transition passing a code of a
