@@ -6,6 +6,8 @@ is reported as such (still without dumping a traceback unless ``MECHC_DEBUG`` is
 
 from __future__ import annotations
 
+from pathlib import Path
+
 EXIT_OK = 0
 EXIT_FAILED = 1  # a proof or design check failed
 EXIT_USAGE = 2  # bad input: spec syntax, unknown file, inconsistent options
@@ -32,3 +34,16 @@ class DesignError(MechcError):
     """The design cannot be built as asked (e.g. a failed design check)."""
 
     exit_code = EXIT_FAILED
+
+
+def read_input(path: str | Path, expected: str, what: str = "file") -> bytes:
+    """The bytes of a file the user named; a file that cannot be read has no line or column to
+    point at, so each I/O problem is a one-line UsageError naming the file."""
+    try:
+        return Path(path).read_bytes()
+    except FileNotFoundError:
+        raise UsageError(f"{path}: file not found") from None
+    except IsADirectoryError:
+        raise UsageError(f"{path}: is a directory, expected {expected}") from None
+    except OSError as e:
+        raise UsageError(f"{path}: cannot read {what}: {e.strerror or e}") from None

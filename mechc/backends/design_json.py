@@ -15,7 +15,7 @@ from pathlib import Path
 import jsonschema
 
 from mechc import FORMAT_VERSION, __version__
-from mechc.errors import SpecError, UsageError
+from mechc.errors import SpecError, UsageError, read_input
 from mechc.frontends.spec_json import seqspec_from_json, spec_from_json
 from mechc.ir.check import Check
 from mechc.ir.design import Design
@@ -145,14 +145,7 @@ DECODE_ERRORS = (KeyError, IndexError, TypeError, ValueError, AttributeError)
 
 def load_design_json(path: str | Path) -> dict:
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except FileNotFoundError:
-        raise UsageError(f"{p}: file not found") from None
-    except IsADirectoryError:
-        raise UsageError(f"{p}: is a directory, expected a design file (.json)") from None
-    except OSError as e:
-        raise UsageError(f"{p}: cannot read design: {e.strerror or e}") from None
+    data = read_input(p, "a design file (.json)", "design")
     try:
         obj = json.loads(data)  # bytes: UTF-8, UTF-16 or UTF-32, as RFC 8259 allows
     except json.JSONDecodeError as e:

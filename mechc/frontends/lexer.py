@@ -10,7 +10,7 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from mechc.errors import SpecError, UsageError
+from mechc.errors import SpecError, read_input
 
 MAX_SPEC_BYTES = 50_000_000
 #: Longest name or number: real ones are a few characters (a column label has one digit per
@@ -49,17 +49,9 @@ _TOKEN_RE = re.compile(
 
 
 def read_text(path: str | Path) -> str:
-    """Read a spec file as UTF-8 text, turning every I/O or encoding problem into a SpecError."""
-    p = Path(path)
-    try:
-        data = p.read_bytes()
-    # a file that cannot be read has no line or column to point at
-    except FileNotFoundError:
-        raise UsageError(f"{path}: file not found") from None
-    except IsADirectoryError:
-        raise UsageError(f"{path}: is a directory, expected a spec file") from None
-    except OSError as e:
-        raise UsageError(f"{path}: cannot read file: {e.strerror}") from None
+    """Read a spec file as UTF-8 text: an encoding problem is a located SpecError, an I/O one a
+    UsageError naming the file."""
+    data = read_input(path, "a spec file")
     if len(data) > MAX_SPEC_BYTES:
         raise SpecError(str(path), 1, 1, f"file is {len(data)} bytes; the limit is "
                         f"{MAX_SPEC_BYTES}")
