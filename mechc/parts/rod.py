@@ -65,7 +65,10 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     A·D ± H·D⊥ from the pivot with A = 1/2 + (r² - L²)/(2d²) and H² = r²/d² - A², so one
     division, one square root and one arctan2 place it; the transmission angle comes from the
     same numbers (law of cosines: arm·rod = (d² - r² - L²)/2, |arm×rod| = H·d²) by arctan2,
-    which unlike arccos of a cosine stays accurate at the toggle (H -> 0)."""
+    which unlike arccos of a cosine stays accurate at the toggle (H -> 0). It is the same
+    circle meeting as :func:`mechc.geometry.circles.circle_meeting`, kept in these units
+    because it is the hot path of every kinematic proof (the transmission angle shares its
+    terms)."""
     mine, theirs = (j.pb, j.pa) if j.b == lever.id else (j.pa, j.pb)
     P = lever.pivot
     r2 = (mine[0] - P[0]) ** 2 + (mine[1] - P[1]) ** 2
