@@ -44,3 +44,16 @@ def test_architecture_names_only_real_paths_and_every_package():
         "*/__init__.py")}
     undocumented = [p for p in sorted(packages) if f"`{p}/`" not in text]
     assert not undocumented, f"packages missing from architecture.md: {undocumented}"
+
+
+README = DOC.parents[1] / "README.md"
+
+
+def test_readme_synth_example_finds_a_healthy_gate(cli):
+    """The README's dimensional-synthesis line, run as printed, must show a success (exit 0),
+    not the failure path (numbers with no healthy design exit 1)."""
+    line = next(ln for ln in README.read_text().splitlines() if "mechc synth three-bar" in ln)
+    args = line.split("#")[0].split()[1:]
+    rc, out, err = cli(*args)
+    assert rc == 0, err
+    assert json.loads(out)["healthy"] is True
