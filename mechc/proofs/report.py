@@ -27,7 +27,7 @@ SUMMARY_KEYS = [
     ("min_margin_fraction", "min margin to mid-stroke (fraction of stroke)"),
     ("max_joint_violation_mm", "max joint violation (mm)"),
     ("max_contact_penetration_mm", "max contact overrun (mm)"),
-    ("max_settle_time_s", "max settle time (s)"),
+    ("max_settle_time_s", "max time outputs moved on after an input stopped (s)"),
     ("min_transmission_angle_deg", "min transmission angle (deg)"),
     ("min_toggle_distance_deg", "min distance from toggle (deg)"),
     ("seconds", "seconds"),
