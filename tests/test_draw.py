@@ -259,12 +259,18 @@ def test_cli_writes_default_name_and_replaces(cli, sorter_json, tmp_path):
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
 
 
-def test_cli_compiles_a_spec(cli, tmp_path):
-    spec = tmp_path / "fa.bool"
+def test_cli_compiles_a_spec(cli, tmp_path, monkeypatch):
+    """A spec's drawing goes to the current directory, never into the folder of the spec."""
+    src, run = tmp_path / "src", tmp_path / "run"
+    src.mkdir()
+    run.mkdir()
+    spec = src / "fa.bool"
     spec.write_text((EXAMPLES / "full_adder.bool").read_text())
+    monkeypatch.chdir(run)
     code, stdout, err = cli("draw", spec, "--state", "a=1,b=1")
     assert code == 0, err
-    assert _outputs((tmp_path / "fa.svg").read_text()) == {"s": 0, "cout": 1}  # 1+1+0 = 10b
+    assert _outputs((run / "fa.svg").read_text()) == {"s": 0, "cout": 1}  # 1+1+0 = 10b
+    assert [p.name for p in src.iterdir()] == ["fa.bool"]
 
 
 def test_unsolved_body_is_shown_and_fails(cli, sorter, sorter_json, tmp_path, monkeypatch):

@@ -22,7 +22,9 @@ def register(sub) -> None:
                        "atomically: on any error an existing file is left untouched. Exit 1 if "
                        "some body cannot be posed in that state (it is drawn dashed red).")
     d.add_argument("design", metavar="SPEC_OR_JSON")
-    d.add_argument("-o", "--output", help="output SVG file (default: the input with .svg)")
+    d.add_argument("-o", "--output", help="output SVG file (default: a design JSON's name with "
+                   ".svg beside it; for a spec, its name with .svg in the current directory, so "
+                   "drawing a spec never writes into the folder of sources)")
     d.add_argument("--state", default="", metavar="A=1,B=0",
                    help="input values (0/1 or off/on); inputs not named are off")
     d.add_argument("--scale", type=float, default=2.0, metavar="PX_PER_MM",
@@ -36,7 +38,7 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     if not math.isfinite(args.scale) or args.scale <= 0:
         raise UsageError(f"--scale must be a positive number of px per mm, got {args.scale:g}")
-    out = args.output or str(Path(args.design).with_suffix(".svg"))
+    out = args.output or default_output(args.design)
     check_output(out, "drawing", [("input", args.design)])
     design = load_design_or_spec(args.design, args)
     if design.mechanism is None:
@@ -54,3 +56,12 @@ def run(args: argparse.Namespace) -> int:
               f"dashed red at their design pose): {', '.join(dr.unsolved)}", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
+
+
+def default_output(design: str) -> str:
+    """Beside a compiled design (a build product); in the current directory for a spec, whose
+    folder holds sources (``draw examples/sorter.bool`` must not write into ``examples/``)."""
+    path = Path(design)
+    if path.suffix.lower() == ".json":
+        return str(path.with_suffix(".svg"))
+    return path.with_suffix(".svg").name
