@@ -34,14 +34,25 @@ def run(quick: bool, out: Path, write_model: Path | None) -> dict:
     t_start = time.perf_counter()
     out.mkdir(parents=True, exist_ok=True)
     b = Bench(load_library(), quick)
+    steps = ["compile the circuits", "proof levels", "pruning", "error grid", "step overhead",
+             "stability study", "peers"]
+
+    def step(k: int) -> None:  # the studies run minutes: say which one is running
+        b.say(f"[{k + 1}/{len(steps)}] {steps[k]} ({time.perf_counter() - t_start:.0f} s so far)")
+
+    step(0)
     cs = bench_circuits(quick, b.say)
     for c in cs:
         b.say(f"{c.name}: {cell_count(c.design)} cells, {len(c.design.spec.inputs)} inputs"
               + (f" [{c.note}]" if c.note else ""))
+    step(1)
     levels(b, cs)
+    step(2)
     pruning(b, cs)
+    step(3)
     grid_rows = grid(b, cs)
     fa = next(c for c in cs if c.name == "full_adder")
+    step(4)
     overhead = step_overhead(b, fa)
     model = error_model(grid_rows, overhead, "benchmarks/speed_accuracy.py"
                         + (" --quick" if quick else ""))
@@ -50,7 +61,9 @@ def run(quick: bool, out: Path, write_model: Path | None) -> dict:
         write_model.write_text(json.dumps(model.to_json(), indent=1) + "\n")
         b.say(f"error model written to {write_model}")
     b.summary["step_overhead_iterations"] = round(overhead, 2)
+    step(5)
     study = stability_study(b, fa)
+    step(6)
     peers(b, next(c for c in cs if c.name == "random30"))
     write_csv(b.rows, out / "speed_accuracy.csv")
     chart(b, out / "speed_accuracy.png")
