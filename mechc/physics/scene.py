@@ -449,6 +449,7 @@ class Scene:
         followers = [(bid, self.bodies[bid], body_kind(self.kind[bid])) for bid in self.boundary]
         sink = self.sink
         every = max(1, int(round(sink.every / st.dt))) if sink is not None else 0
+        sampled = 0  # the last step sampled
         if sink is not None:
             sink.sample(self, 0.0, 0.0)
         frac = 0.0
@@ -503,9 +504,10 @@ class Scene:
                         quiet_since = None
             if sink is not None and step % every == 0:
                 sink.sample(self, t, frac)
+                sampled = step
             if not np.isfinite(max_v):
                 break
-        if sink is not None and step % every:
+        if sink is not None and sampled != step:  # the pose it ends in (also after a break)
             sink.sample(self, step * st.dt, frac)
         self.state[name] = target
         self.mem_state = dict(self._last_state)
