@@ -13,10 +13,12 @@ import pytest
 
 from mechc.backends.design_json import design_from_json, load_design_json
 from mechc.cells.library import load_library
+from mechc.errors import UsageError
 from mechc.ir.mechanism import GROUND
 from mechc.parts.base import position
 from mechc.physics.evaluate import evaluate
-from mechc.proofs.trace import schema
+from mechc.proofs import ProofSettings, prove
+from mechc.proofs.trace import TraceRecorder, schema
 from tests.helpers import EXAMPLES
 
 SORTER = EXAMPLES / "sorter.bool"
@@ -224,3 +226,13 @@ def test_trace_never_overwrites_the_design_or_the_report(cli, tmp_path, sorter_j
                        "--report", both)
     assert code == 2 and "refusing to overwrite the report" in err
     assert not both.exists()
+
+
+@pytest.mark.parametrize("level", ["kinematic", "dynamic"])
+def test_a_trace_too_large_stops_the_proof_with_a_usage_error(sorter_json, level):
+    design = design_from_json(load_design_json(sorter_json), str(sorter_json))
+    limit = 40 * len(design.mechanism.body_index())  # fewer samples than either proof visits
+    rec = TraceRecorder(design.mechanism, max_poses=limit)
+    with pytest.raises(UsageError, match=f"more than {limit:,} body poses"):
+        prove(design, design.spec, load_library([]), level,
+              ProofSettings(trace=rec, cases=0))

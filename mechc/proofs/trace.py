@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from mechc import __version__
+from mechc.errors import UsageError
 from mechc.ir.mechanism import Body, Mechanism, Terminal
 from mechc.logic.cubes import DC
 from mechc.parts import body_kind
@@ -43,6 +44,10 @@ VERSION = 1
 #: enough to animate an 80 ms input move in 40 frames; the sorter's default proof traces to
 #: about 1 MB (docs/trace.md).
 EVERY_S = 0.002
+#: Most body poses (bodies × samples) one trace holds, about 130 MB of JSON: beyond, the proof
+#: stops with a usage error rather than fill the memory (a kinematic trace of ten inputs and a
+#: hundred bodies would hold 11 million).
+MAX_POSES = 5_000_000
 MM_DIGITS = 4  # 0.1 µm
 RAD_DIGITS = 6  # 1 µrad: 0.1 µm at 100 mm from the reference point
 TIME_DIGITS = 6
@@ -51,8 +56,11 @@ TIME_DIGITS = 6
 class TraceRecorder:
     """Collects the cases of one proof, each a list of samples of every body's pose."""
 
-    def __init__(self, mech: Mechanism, every: float = EVERY_S, move_time: float = 0.08):
+    def __init__(self, mech: Mechanism, every: float = EVERY_S, move_time: float = 0.08,
+                 max_poses: int = MAX_POSES):
         self.mech = mech
+        self.max_poses = max_poses
+        self.poses = 0  # body poses recorded so far
         self.every = every  # dynamic level: s between samples (the scene's PoseSink)
         self.move_time = move_time  # kinematic level: nominal s for a whole change
         self.owner: dict[str, str] = {}
@@ -71,6 +79,13 @@ class TraceRecorder:
         self._taken: list[np.ndarray] = []
         self._ids: list[str] | None = None
         self._rows = np.zeros(0, dtype=np.int64)
+
+    def _count(self, samples: int) -> None:
+        self.poses += samples * len(self.bodies)
+        if self.poses > self.max_poses:
+            raise UsageError(f"the trace would hold more than {self.max_poses:,} body poses "
+                             f"({len(self.bodies)} bodies per sample): trace fewer cases "
+                             "(--cases), sample less often (--trace-every) or a smaller design")
 
     def _own(self, bodies: list[Body], part_bodies: list[Body], owner: str) -> None:
         for b in part_bodies:
@@ -96,6 +111,7 @@ class TraceRecorder:
 
     def take(self, poses: Poses, size: int) -> None:
         """Keep the poses of states the sweep evaluates, in its order (``add_sweep``)."""
+        self._count(size)
         self._taken.append(self.frames_of(poses, size))
 
     def add_sweep(self, sw: dict, spec) -> None:
@@ -117,19 +133,26 @@ class TraceRecorder:
         for i in range(n_rest):
             ins = _bits(rest_bits[:, i], names)
             want = {o: v[i] for o, v in rest_want.items()}
-            self.add("rest", None, ins, ins, want, want, [0.0], [1.0], frames[i:i + 1])
+            self._append("rest", None, ins, ins, want, want, [0.0], [1.0], frames[i:i + 1])
         frac = np.linspace(0.0, 1.0, samples)
         for j in range(len(e_k)):
             s = n_rest + j * samples
-            self.add("change", names[e_k[j]], _bits(edge_bits[:, j], names),
-                     _bits(hi_bits[:, j], names), {o: v[j] for o, v in lo_want.items()},
-                     {o: v[j] for o, v in hi_want.items()}, frac * self.move_time, frac,
-                     frames[s:s + samples])
+            self._append("change", names[e_k[j]], _bits(edge_bits[:, j], names),
+                         _bits(hi_bits[:, j], names), {o: v[j] for o, v in lo_want.items()},
+                         {o: v[j] for o, v in hi_want.items()}, frac * self.move_time, frac,
+                         frames[s:s + samples])
 
     def add(self, kind: str, moving: str | None, before: dict, after: dict,
             expected_before: dict, expected_after: dict, t, frac, frames: np.ndarray,
             **extra: Any) -> None:
         """One case with all its samples (``frames``: (samples, bodies, 3))."""
+        self._count(len(frames))
+        self._append(kind, moving, before, after, expected_before, expected_after, t, frac,
+                     frames, **extra)
+
+    def _append(self, kind: str, moving: str | None, before: dict, after: dict,
+                expected_before: dict, expected_after: dict, t, frac, frames: np.ndarray,
+                **extra: Any) -> None:
         self.cases.append({**_case_head(len(self.cases), kind, moving, before, after,
                                         expected_before, expected_after, extra),
                            "t": _round(np.asarray(t, dtype=float), TIME_DIGITS),
@@ -149,6 +172,7 @@ class TraceRecorder:
         does not hold is NaN."""
         if self._open is None:
             return
+        self._count(1)
         ids, pos, ang = scene.frames()
         if ids is not self._ids:  # a new scene: where its bodies go in the trace's order
             self._ids = ids
