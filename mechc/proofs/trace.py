@@ -44,7 +44,7 @@ VERSION = 1
 #: enough to animate an 80 ms input move in 40 frames; the sorter's default proof traces to
 #: about 1 MB (docs/trace.md).
 EVERY_S = 0.002
-#: Most body poses (bodies × samples) one trace holds, about 130 MB of JSON: beyond, the proof
+#: Most body poses (bodies × samples) one trace holds, about 100 MB of JSON: beyond, the proof
 #: stops with a usage error rather than fill the memory (a kinematic trace of ten inputs and a
 #: hundred bodies would hold 11 million).
 MAX_POSES = 5_000_000
@@ -290,7 +290,8 @@ def _pt(p) -> list[float]:
 
 
 def _body_json(b: Body, owner: str, ref) -> dict:
-    d = {"id": b.id, "kind": b.kind, "owner": owner, "layer": b.layer, "ref": _pt(ref),
+    d = {"id": b.id, "kind": b.kind, "role": b.role, "owner": owner, "layer": b.layer,
+         "ref": _pt(ref),
          "outline": [[_pt(p) for p in poly] for poly in b.outline]}
     if b.poly_layers:
         d["poly_layers"] = list(b.poly_layers)
