@@ -12,7 +12,9 @@ from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 from mechc.ir.design import Design
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
+from mechc.physics.scene import DynSettings
 from mechc.proofs import LEVELS, ProofReport, ProofSettings, prove, spec_kind
+from mechc.proofs import trace as pose_trace
 from mechc.ui import Progress, finite_float
 
 
@@ -57,6 +59,12 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.add_argument("--spec", metavar="OTHER",
                    help="prove against this spec instead of the one the design was compiled from")
     s.add_argument("--report", metavar="FILE.json", help="write the proof report as JSON")
+    s.add_argument("--trace", metavar="FILE.json",
+                   help="kinematic and dynamic: write every body's pose in every case the "
+                   "proof visits as JSON (docs/trace.md)")
+    s.add_argument("--trace-every", type=finite_float, default=None, metavar="S",
+                   help="dynamic: seconds of simulated time between trace samples (default "
+                   f"{pose_trace.EVERY_S}; each change's start and end are always sampled)")
     compile_options(s)
     s.set_defaults(func=run)
 
@@ -81,6 +89,19 @@ def _check_options(args: argparse.Namespace) -> None:
             raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
     if args.report:  # before a proof that may take minutes, not after it
         check_output(args.report, "report", [("design", args.design), ("spec", args.spec)])
+    if args.trace_every is not None:
+        if not args.trace or args.level != "dynamic":
+            raise UsageError("--trace-every spaces the samples of a dynamic --trace")
+        if args.trace_every <= 0:
+            raise UsageError("--trace-every must be positive")
+    if args.trace:
+        if args.level == "logic":
+            raise UsageError("--trace records body poses: the logic level has none (use "
+                             "--level kinematic or dynamic)")
+        if args.prune:
+            raise UsageError("--trace records the whole scene: it cannot be taken with --prune")
+        check_output(args.trace, "trace", [("design", args.design), ("spec", args.spec),
+                                           ("report", args.report)])
 
 
 def run(args: argparse.Namespace) -> int:
@@ -89,23 +110,39 @@ def run(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec) if args.spec else design.spec
     lib = load_library(args.cell_dirs)
     try:
-        report = _prove(args, design, spec, lib)
+        trace = _recorder(args, design)
+        report = _prove(args, design, spec, lib, trace)
     except UsageError as e:  # the options were checked: this is about the design, name it
         raise UsageError(f"{args.design}: {e}") from None
     report.source = {"design": args.design, "spec": args.spec or design.spec.path}
     print(report.summary_text())
     if args.report:
         write_atomic(args.report, dumps(report.to_json()))
+    if trace is not None:
+        doc = trace.to_json(report, list(spec.inputs), list(spec.outputs), report.source)
+        write_atomic(args.trace, pose_trace.dumps(doc))
     return EXIT_OK if report.passed else EXIT_FAILED
 
 
-def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: Library
-           ) -> ProofReport:
+def _recorder(args: argparse.Namespace, design: Design) -> pose_trace.TraceRecorder | None:
+    """The pose recorder ``--trace`` asks for (None: nothing is recorded)."""
+    if not args.trace:
+        return None
+    if design.mechanism is None:
+        raise UsageError("the design has no geometry (compile it with this mechc version)")
+    return pose_trace.TraceRecorder(
+        design.mechanism, every=args.trace_every or pose_trace.EVERY_S,
+        move_time=args.move_time or DynSettings().move_time)
+
+
+def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: Library,
+           trace: pose_trace.TraceRecorder | None = None) -> ProofReport:
     """The proof at ``args.level`` of ``design`` against ``spec`` (a ProofReport), with a
     progress bar while a dynamic proof runs."""
     settings = ProofSettings(tolerance=args.tolerance, seed=args.seed, cases=args.cases,
                              prune=args.prune, accuracy=args.accuracy, dt=args.dt,
-                             iterations=args.iterations, move_time=args.move_time)
+                             iterations=args.iterations, move_time=args.move_time,
+                             trace=trace)
     if args.level != "dynamic":
         return prove(design, spec, lib, args.level, settings)
     what = "sequential dynamic" if spec_kind(spec) == "sequential" else "dynamic"

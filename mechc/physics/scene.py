@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 import pymunk
@@ -39,7 +40,8 @@ from mechc.physics.closed_form import Poses
 from mechc.physics.evaluate import CellModels, output_signals, settle
 
 # FAR and N are part of this module's interface (cells' build_dynamics use them)
-__all__ = ["FAR", "MOVE_SAMPLES", "N", "DynSettings", "MoveResult", "Scene", "min_jerk"]
+__all__ = ["FAR", "MOVE_SAMPLES", "N", "DynSettings", "MoveResult", "PoseSink", "Scene",
+           "min_jerk"]
 
 MOVE_SAMPLES = 41  # closed-form samples along an input move (boundary drive and reference)
 
@@ -82,6 +84,16 @@ class MoveResult:
     watched: dict[str, np.ndarray] = field(default_factory=dict)  # Scene.watch sliders' u (mm)
 
 
+class PoseSink(Protocol):
+    """What receives every body's pose while a move runs (a trace, ``mechc.proofs.trace``):
+    ``sample`` is called before the first step, every ``every`` seconds of simulated time and
+    after the last step; it reads the poses with :meth:`Scene.frames`."""
+
+    every: float  # s between samples
+
+    def sample(self, scene: Scene, t: float, frac: float) -> None: ...
+
+
 @dataclass
 class _J:
     """A joint's anchors for violation measurement (body index -1 = ground, world coords)."""
@@ -115,6 +127,7 @@ class Scene:
     state: dict[str, float] = field(default_factory=dict)  # current input values
     mem_state: dict[str, float] = field(default_factory=dict)  # stateful cells (MEMORY)
     watch: list[str] = field(default_factory=list)  # slider bodies whose u each move records
+    sink: PoseSink | None = None  # receives every body's pose while a move runs (a trace)
 
     # ---- building ---------------------------------------------------------------------------
     @staticmethod
@@ -284,6 +297,13 @@ class Scene:
         n = len(self._order)
         return self._P[:n].copy(), self._A[:n].copy()
 
+    def frames(self) -> tuple[list[str], np.ndarray, np.ndarray]:
+        """Every body's id, and now the world position (n, 2) of its ``ref`` point and its
+        angle (n,) from the design pose: a point p of the body (design pose) stands at
+        R(angle)·(p − ref) + position."""
+        pos, ang = self._state()
+        return self._order, pos, ang
+
     def violations(self, pos, ang) -> np.ndarray:
         """Per joint: anchor separation (pivot), length error (rod), distance of the pin from
         its slot segment (groove, guide), overrun (contact); a non-finite pose is infinite."""
@@ -427,6 +447,12 @@ class Scene:
         total = n_move + n_hold
         final_seen: list[dict] = []
         followers = [(bid, self.bodies[bid], body_kind(self.kind[bid])) for bid in self.boundary]
+        sink = self.sink
+        every = max(1, int(round(sink.every / st.dt))) if sink is not None else 0
+        sampled = 0  # the last step sampled
+        if sink is not None:
+            sink.sample(self, 0.0, 0.0)
+        frac = 0.0
         for step in range(1, total + 1):
             t = step * st.dt
             tau = min(1.0, t / st.move_time)
@@ -476,8 +502,13 @@ class Scene:
                             break
                     else:
                         quiet_since = None
+            if sink is not None and step % every == 0:
+                sink.sample(self, t, frac)
+                sampled = step
             if not np.isfinite(max_v):
                 break
+        if sink is not None and sampled != step:  # the pose it ends in (also after a break)
+            sink.sample(self, step * st.dt, frac)
         self.state[name] = target
         self.mem_state = dict(self._last_state)
         final = final_seen[-1] if final_seen else self.outputs_now(*self._state())

@@ -36,6 +36,7 @@ from mechc.proofs.prune import FREEZE, blocker, run_case
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings, dyn_settings
+from mechc.proofs.trace import TraceRecorder
 
 MAX_LISTED = 50
 PRUNE_DEFAULT = False  # per-change pruned scenes (mechc.proofs.prune); see docs/performance.md
@@ -57,12 +58,13 @@ def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSett
     if settings.accuracy is not None:
         return prove_with_accuracy(design, spec, lib, settings.accuracy,
                                    tolerance=settings.tolerance, extra=settings.cases,
-                                   seed=settings.seed, progress=progress, prune=settings.prune)
+                                   seed=settings.seed, progress=progress, prune=settings.prune,
+                                   trace=settings.trace)
     st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
                       move_time=settings.move_time)
     return prove_dynamic(design, spec, lib, st, tolerance=settings.tolerance,
                          extra=settings.cases, seed=settings.seed, progress=progress,
-                         prune=settings.prune or PRUNE_DEFAULT)
+                         prune=settings.prune or PRUNE_DEFAULT, trace=settings.trace)
 
 
 def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSettings | None = None,
@@ -70,7 +72,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                   progress: Callable[[int, int], None] | None = None,
                   cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
                   max_cases: int | None = None, record: list | None = None,
-                  freeze: str | None = None) -> ProofReport:
+                  freeze: str | None = None, trace: TraceRecorder | None = None
+                  ) -> ProofReport:
     """``prune``: each change runs on its own scene holding only what can move the outputs
     (``mechc.proofs.prune``; every change then starts from the closed-form rest pose); else one
     scene of the whole mechanism (or of ``cells``) runs the whole tour. ``max_cases`` keeps
@@ -90,7 +93,12 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     if why_not is None:
         why_not = blocker(design.netlist, lib)
     prune = why_not is None
+    if prune and trace is not None:
+        raise UsageError("a pose trace records the whole scene: it cannot be taken with "
+                         "per-change pruned scenes (--prune)")
     scene = None if prune else Scene.build(mech, lib, types, st, {k: 0.0 for k in names}, cells)
+    if trace is not None:
+        scene.sink = trace
     state = {k: 0.0 for k in names}
     sizes: list[tuple[int, int, int]] = []  # pruned scenes: (cells, dynamic bodies, constraints)
     escalated = 0
@@ -121,7 +129,13 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
             escalated += run.escalated
             max_watch = max(max_watch, run.watch_deviation)
         else:
+            if trace is not None:
+                trace.begin("change", name, _vec(cur, names), _vec(vec, names),
+                            {o: wants[o][i] for o in spec.outputs},
+                            {o: wants[o][i + 1] for o in spec.outputs})
             r = scene.move(name, float(target))
+            if trace is not None:
+                trace.end()
         state[name] = float(target)
         steps += r.steps
         case = {"inputs": _vec(vec, names), "moving": name, "to": int(target)}
@@ -206,16 +220,18 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
 
 
 def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
-                        model: ErrorModel | None = None, **kw) -> ProofReport:
+                        model: ErrorModel | None = None, trace: TraceRecorder | None = None,
+                        **kw) -> ProofReport:
     """``prove_dynamic`` at the cheapest settings meeting ``target``
     (:mod:`mechc.proofs.accuracy`), confirmed on the run; the report says which settings, what
-    error was obtained, and fails if it was not met."""
+    error was obtained, and fails if it was not met. ``trace`` records the proof's run (not
+    the step-halving check's)."""
     model = model or load_model()
     point = choose(target, model)
     st = dyn_settings(design, dt=point.dt, iterations=point.iterations,
                       move_time=point.move_time)
     coarse: list[dict] = []
-    report = prove_dynamic(design, spec, lib, st, record=coarse, **kw)
+    report = prove_dynamic(design, spec, lib, st, record=coarse, trace=trace, **kw)
     half = replace(st, dt=st.dt / 2)
     fine: list[dict] = []
     kw_half = {k: v for k, v in kw.items() if k != "progress"}

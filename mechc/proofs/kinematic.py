@@ -11,6 +11,7 @@ cells' logic types: positions come from the geometry.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -19,13 +20,14 @@ from mechc.errors import UsageError
 from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
-from mechc.physics.closed_form import KinematicsError
+from mechc.physics.closed_form import KinematicsError, Poses
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.physics.measures import CheckStats
 from mechc.proofs.cases import bits, single_changes
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings
+from mechc.proofs.trace import TraceRecorder
 
 EXHAUSTIVE_MAX_INPUTS = 10
 MAX_LISTED = 50
@@ -33,14 +35,16 @@ MAX_LISTED = 50
 
 def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
           inputs_order: list[str] | None = None, stats: CheckStats | None = None,
-          budget: int = 20_000_000, sample: int = 512, max_states: int | None = None):
+          budget: int = 20_000_000, sample: int = 512, max_states: int | None = None,
+          on_poses: Callable[[Poses, int], None] | None = None):
     """Evaluate rest states and single-input changes (``samples`` points along the moving
     input), in chunks so memory stays bounded; returns output signals only, and feeds the
     design-check statistics ``stats`` as it goes.
 
     Up to 10 inputs every vector and every single-input change; beyond, a seeded sample of
     ``sample`` vectors and as many changes (as boolean matrices, so any number of inputs
-    works)."""
+    works). ``on_poses`` receives the poses of every chunk of states in the order evaluated
+    (the rest states, then each change's samples): a trace."""
     mech = design.mechanism
     names = inputs_order or list(design.netlist.inputs)
     n = len(names)
@@ -76,6 +80,8 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
             poses = evaluate(mech, lib, types, {nm: part[k] for k, nm in enumerate(names)})
             if stats is not None:
                 stats.add(poses)
+            if on_poses is not None:
+                on_poses(poses, part.shape[1])
             for o, v in output_signals(mech, poses).items():
                 outs.setdefault(o, []).append(np.broadcast_to(v, (part.shape[1],)))
         return {o: np.concatenate(v) for o, v in outs.items()}
@@ -99,11 +105,13 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
 @engine("kinematic", "combinational")
 def kinematic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
                      progress: OnProgress | None) -> ProofReport:
-    return prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed)
+    return prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed,
+                           trace=settings.trace)
 
 
 def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float = 0.05,
-                    samples: int = 21, seed: int = 0) -> ProofReport:
+                    samples: int = 21, seed: int = 0,
+                    trace: TraceRecorder | None = None) -> ProofReport:
     t0 = time.perf_counter()
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
@@ -112,9 +120,12 @@ def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float =
     mech = design.mechanism
     stats = CheckStats(mech)
     try:
-        sw = sweep(design, lib, samples, seed, names, stats)
+        sw = sweep(design, lib, samples, seed, names, stats,
+                   on_poses=trace.take if trace is not None else None)
     except KinematicsError as e:
         raise UsageError(f"the geometry is not a determinate mechanism: {e}") from None
+    if trace is not None:
+        trace.add_sweep(sw, spec)
     rest_bits, edge_bits, e_k = sw["rest_bits"], sw["edge_bits"], sw["e_k"]
     rest_want = spec.values_at(rest_bits)
     lo_want = spec.values_at(edge_bits)

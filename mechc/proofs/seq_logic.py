@@ -470,6 +470,25 @@ def _path_to_untaken(g, cur, untaken):
 def expected_after(spec: SeqSpec, sequence: list[dict[str, int]]) -> list[dict[str, int | None]]:
     """The spec's outputs at the stable state after each input vector of ``sequence`` (the
     first must be the power-up vector; each next one differs in one input and is specified)."""
+    return [output_values(spec, s, x) for x, s in _stable_walk(spec, sequence)]
+
+
+def expected_states(spec: SeqSpec, sequence: list[dict[str, int]]) -> list[str]:
+    """The name of the spec's stable state after each input vector of ``sequence``: the flow
+    table's row, or the memories' values ("M1=0 M2=1") of a set/reset spec."""
+    out = []
+    for _, s in _stable_walk(spec, sequence):
+        if spec.table is not None:
+            out.append(spec.table.rows[s])
+        else:
+            m = spec.memory_names
+            out.append(" ".join(f"{nm}={(s >> (len(m) - 1 - j)) & 1}"
+                                for j, nm in enumerate(m)))
+    return out
+
+
+def _stable_walk(spec: SeqSpec, sequence: list[dict[str, int]]):
+    """(inputs, stable state) after each input vector of ``sequence``, from power-up."""
     n = spec.n
 
     def vec(d: dict[str, int]) -> int:
@@ -479,7 +498,7 @@ def expected_after(spec: SeqSpec, sequence: list[dict[str, int]]) -> list[dict[s
     if not sequence or vec(sequence[0]) != x:
         raise ValueError(f"a sequence must start at the power-up inputs "
                          f"{bits_text(x, n)}")
-    out = [output_values(spec, s, x)]
+    yield x, s
     for d in sequence[1:]:
         x2 = vec(d)
         if x2 not in allowed_changes(spec, s, x):
@@ -487,5 +506,4 @@ def expected_after(spec: SeqSpec, sequence: list[dict[str, int]]) -> list[dict[s
                              f"single-input change from {describe_total(spec, x, s)}")
         s = next_stable(spec, s, x, x2)
         x = x2
-        out.append(output_values(spec, s, x))
-    return out
+        yield x, s

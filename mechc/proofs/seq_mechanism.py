@@ -28,8 +28,9 @@ from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, Scene
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
-from mechc.proofs.seq_logic import expected_after, transition_tour
+from mechc.proofs.seq_logic import expected_after, expected_states, transition_tour
 from mechc.proofs.settings import ProofSettings, dyn_settings
+from mechc.proofs.trace import TraceRecorder
 
 MAX_LISTED = 50
 
@@ -97,24 +98,27 @@ def sequential_kinematic_engine(design: Design, spec: SeqSpec, lib: Library,
                                 settings: ProofSettings,
                                 progress: OnProgress | None) -> ProofReport:
     return prove_sequential_kinematic(design, spec, lib, tolerance=settings.tolerance,
-                                      seed=settings.seed)
+                                      seed=settings.seed, trace=settings.trace)
 
 
 def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float = 0.05,
                                samples: int = 21, seed: int = 0, random_walks: int = 4,
-                               stats: CheckStats | None = None) -> ProofReport:
+                               stats: CheckStats | None = None,
+                               trace: TraceRecorder | None = None) -> ProofReport:
     """Walk the closed form through the spec's sequences (each step sampled along the moving
-    input, the stateful cells settled at every sample)."""
+    input, the stateful cells settled at every sample); ``trace`` receives every body's pose
+    at power-up and along every step."""
     try:
         return _prove_sequential_kinematic(design, spec, lib, tolerance, samples, seed,
-                                           random_walks, stats)
+                                           random_walks, stats, trace)
     except KinematicsError as e:  # as the combinational kinematic proof reports it
         raise UsageError(f"the geometry is not a determinate mechanism: {e}") from None
 
 
 def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float,
                                 samples: int, seed: int, random_walks: int,
-                                stats: CheckStats | None) -> ProofReport:
+                                stats: CheckStats | None,
+                                trace: TraceRecorder | None) -> ProofReport:
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)
     mems = stateful_cells(design, lib)
@@ -131,6 +135,11 @@ def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: f
             stats.add(poses)
         _judge_outputs(fails, {"sequence": si, "step": 0}, _last(output_signals(mech, poses)),
                        {}, {}, want[0], tolerance, dev)
+        state_names = expected_states(spec, seq) if trace is not None else []
+        if trace is not None:
+            trace.add("rest", None, seq[0], seq[0], want[0], want[0], [0.0], [1.0],
+                      trace.frames_of(poses, 1), sequence=si, step=0,
+                      expected_state=state_names[0])
         for k in range(1, len(seq)):
             moved = next(n for n in seq[k] if seq[k][n] != cur[n])
             vals = {n: np.full(samples, v) for n, v in cur.items()}
@@ -150,6 +159,10 @@ def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: f
                 fails.add("oscillation", **where, message="the states keep changing")
             outs = output_signals(mech, poses)
             _judge_outputs(fails, where, _last(outs), outs, want[k - 1], want[k], tolerance, dev)
+            if trace is not None:
+                trace.add("change", moved, seq[k - 1], seq[k], want[k - 1], want[k],
+                          t * trace.move_time, t, trace.frames_of(poses, samples),
+                          sequence=si, step=k, expected_state=state_names[k])
             state = path_state
             cur = {n: float(v) for n, v in seq[k].items()}
             steps += 1
@@ -205,17 +218,19 @@ def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
                       move_time=settings.move_time)
     return prove_sequential_dynamic(design, spec, lib, settings=st,
                                     tolerance=settings.tolerance, seed=settings.seed,
-                                    progress=progress)
+                                    progress=progress, trace=settings.trace)
 
 
 def prove_sequential_dynamic(design: Design, spec, lib: Library,
                              settings: DynSettings | None = None, tolerance: float = 0.05,
                              seed: int = 0, random_walks: int = 2,
                              progress: Callable[[int, int], None] | None = None,
-                             sequences: list[list[dict[str, int]]] | None = None) -> ProofReport:
+                             sequences: list[list[dict[str, int]]] | None = None,
+                             trace: TraceRecorder | None = None) -> ProofReport:
     """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
     each from the power-up inputs); a fresh scene per sequence starts at power-up. Without
-    ``settings``, the defaults with the circuit's settle allowance (``dyn_settings``)."""
+    ``settings``, the defaults with the circuit's settle allowance (``dyn_settings``).
+    ``trace`` receives every body's pose at power-up and along every step."""
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)
     st = settings or dyn_settings(design, lib)
@@ -233,9 +248,21 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
         scene = Scene.build(mech, lib, types, st, cur)
         watch = _memory_inputs(mech, lib, types, scene)
         scene.watch = [b for pair in watch.values() for b in pair]
+        state_names = expected_states(spec, seq) if trace is not None else []
+        if trace is not None:
+            scene.sink = trace
+            trace.begin("rest", None, seq[0], seq[0], want[0], want[0], sequence=si, step=0,
+                        expected_state=state_names[0])
+            trace.sample(scene, 0.0, 1.0)
+            trace.end()
         for k in range(1, len(seq)):
             moved = next(n for n in seq[k] if seq[k][n] != cur[n])
+            if trace is not None:
+                trace.begin("change", moved, seq[k - 1], seq[k], want[k - 1], want[k],
+                            sequence=si, step=k, expected_state=state_names[k])
             r = scene.move(moved, float(seq[k][moved]))
+            if trace is not None:
+                trace.end()
             where = {"sequence": si, "step": k, "moving": moved, "to": int(seq[k][moved]),
                      "inputs": {n: int(v) for n, v in seq[k].items()}}
             if r.max_violation > max_vio:

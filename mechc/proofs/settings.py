@@ -3,13 +3,14 @@ proof runs at unless told otherwise (:func:`dyn_settings`)."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import networkx as nx
 
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.physics.scene import DynSettings
+from mechc.proofs.trace import TraceRecorder
 
 #: A bilateral joint may stretch this share of the stroke before the proof calls it a solver
 #: error (0.1 mm at the default 20 mm stroke).
@@ -32,6 +33,9 @@ class ProofSettings:
     dt: float | None = None  # dynamic: solver time step (s); None: DynSettings' default
     iterations: int | None = None  # dynamic: solver iterations per step
     move_time: float | None = None  # dynamic: seconds an input takes to move
+    # kinematic and dynamic: receives every body's pose in every case visited (nothing is
+    # recorded without one); it never changes what the proof checks or reports
+    trace: TraceRecorder | None = field(default=None, compare=False, repr=False)
 
 
 def dyn_settings(design: Design, lib: Library | None = None, dt: float | None = None,
