@@ -243,6 +243,23 @@ def test_abutting_faces_may_touch_but_not_overlap():
     assert "contact faces overrun" in failures(d2)[0].detail
 
 
+def test_threshold_cranks_sweep_clear_of_each_other():
+    """FV 27 (a·c̄ + b·c, weights 3 2 1) with --map threshold: input cranks A and B sweep
+    across each other; crank B has a plane of its own. Put it back on A's plane: rejected."""
+    spec = parse_bool("inputs a b c\noutputs z\nz = minterms(3, 4, 6, 7)\n")
+    opts = CompileOptions()
+    opts.map = dataclasses.replace(opts.map, target="threshold")
+    d = compile_spec(spec, opts, LIB)
+    assert not failures(d)
+    bodies = d.mechanism.body_index()
+    assert bodies["t1.crank_B"].layer != bodies["t1.crank_A"].layer
+    bodies["t1.crank_B"].layer = bodies["t1.crank_A"].layer
+    run_design_checks(d, LIB)
+    bad = failures(d)
+    assert [c.where for c in bad] == ["t1.crank_A / t1.crank_B"]
+    assert bad[0].value < -1.0 and "during a change" in bad[0].detail
+
+
 # ---- through the command line: a user cell, the clearance option -------------------------------
 
 CELL = '''
