@@ -42,6 +42,10 @@ PROFILE_POINTS = 720  # cam outline vertices (0.5 deg apart) for the drawing and
 TOUCH_SLACK_DEG = 3.0  # contact arc beyond the cam angles the roller can reach
 CAM_RANGE_TOL = np.radians(4.9)  # the closed cam dwells 5 deg beyond its working range
 CAM_FRICTION = 0.05  # coefficient between cam and roller (a rolling roller: small)
+# planes of the input cranks (input sliders take planes 0..2, the separator links 5..9): cranks
+# A and B, and B and C, sweep across each other in some generators (24 of the 256 functions), so
+# B has a plane of its own; A and C never come near (the interference design check watches them)
+CRANK_PLANES = {"A": 4, "B": 3, "C": 4}
 
 
 def truth_table(params: dict, n: int) -> tuple[int, ...]:
@@ -190,8 +194,8 @@ def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,
         polys = [bar_poly(ctr, pinp, w)]
         if d.primed[c]:
             polys.append(bar_poly(ctr, drv, w))
-        b.part.bodies.append(Body(crank, "lever", polys, ctx.mass(polys), pivot=ctr, layer=4,
-                                  role=f"input crank {c} ({pin})"))
+        b.part.bodies.append(Body(crank, "lever", polys, ctx.mass(polys), pivot=ctr,
+                                  layer=CRANK_PLANES[c], role=f"input crank {c} ({pin})"))
         b.rod(b.name(f"in_{pin}"), crank, (1.5 * S, y), drv)
 
     # --- separator links ---------------------------------------------------------------------

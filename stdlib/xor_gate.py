@@ -25,6 +25,10 @@ def build_xor(b: Builder, demand: Demand):
     bar2, _ = b.and_bar("bar2", [bb, na], x2, Demand(), y_extra=[rows[1]])
     bar1.y, bar2.y = rows
     bar3, (l1, l2) = b.or_bar("bar3", [bar1, bar2], x3, demand)
+    # bar1's lug to the OR bar passes bar2: it runs on the sliders' plane, as every lug that
+    # pushes a bar does (on the bars' plane it would cut through bar2)
+    body1 = b.part.body(bar1.body)
+    body1.poly_layers = [body1.layer] * (len(body1.outline) - 1) + [0]
     la, lnb = b.size(bar1.body, l1)  # the AND bars must push the OR bar
     lb, lna = b.size(bar2.body, l2)
     load_a = la + Demand(lna.left + f, lna.right + f)

@@ -322,7 +322,7 @@ def mechanism_from_json(d: dict, cells: list[dict]) -> Mechanism:
     ctx = SynthContext(**{k: v for k, v in d.get("rules", {}).items() if k in names})
     cell_parts = {c["id"]: Part.from_json(c["geometry"]) for c in cells if "geometry" in c}
     checks = [Check(c["name"], c["where"], float(c["value"]), float(c["limit"]), c["sense"],
-                    c.get("unit", "")) for c in d.get("checks", [])]
+                    c.get("unit", ""), c.get("detail", "")) for c in d.get("checks", [])]
     return Mechanism(ctx, cell_parts,
                      {k: Part.from_json(p) for k, p in d["inputs"].items()},
                      {k: Part.from_json(p) for k, p in d["nets"].items()},

@@ -53,6 +53,9 @@ def compile_options(c: argparse.ArgumentParser) -> None:
                    help="rated force of each input actuator (default: %(default)s N)")
     m.add_argument("--output-load", type=finite_float, default=0.5, metavar="N",
                    help="force each circuit output must move either way (default: %(default)s N)")
+    m.add_argument("--clearance", type=finite_float, default=1.0, metavar="MM",
+                   help="least gap between two parts on one plane in any state the design "
+                   "checks visit; closer fails the interference check (default: %(default)s mm)")
     m.add_argument("--no-amplify", action="store_true",
                    help="never insert AMPLIFIER cells by itself (by default they go where an "
                    "actuator or a MEMORY loop is short of force, and before a sequential output "
@@ -68,6 +71,8 @@ def options_from_args(args: argparse.Namespace) -> CompileOptions:
         raise UsageError("--stroke must be between 1 and 500 mm")
     if args.actuator_force <= 0 or args.output_load < 0:
         raise UsageError("--actuator-force must be positive and --output-load not negative")
+    if not 0.0 <= args.clearance <= 100.0:
+        raise UsageError("--clearance must be between 0 and 100 mm")
     return CompileOptions(
         minimise=MinimiseOptions(time_limit=args.time_limit, share=not args.no_share,
                                  complements=args.phase == "auto",
@@ -77,7 +82,7 @@ def options_from_args(args: argparse.Namespace) -> CompileOptions:
                        prefer=tuple(getattr(args, "use_cell", ())),
                        target=getattr(args, "map_target", "conventional")),
         mech=MechOptions(stroke=args.stroke, actuator_force=args.actuator_force,
-                         output_load=args.output_load),
+                         output_load=args.output_load, clearance=args.clearance),
         cell_dirs=tuple(args.cell_dirs),
         amplify=not getattr(args, "no_amplify", False),
         timings=getattr(args, "timings", False),

@@ -16,6 +16,7 @@ class Check:
     limit: float
     sense: str  # ">=" or "<="
     unit: str = ""
+    detail: str = ""  # where and how it was measured (e.g. the state of an interference)
 
     @property
     def passed(self) -> bool:
@@ -25,16 +26,20 @@ class Check:
         return bool(v >= self.limit if self.sense == ">=" else v <= self.limit)
 
     def to_json(self) -> dict:
-        return {"name": self.name, "where": self.where, "value": round(float(self.value), 4),
-                "limit": self.limit, "sense": self.sense, "unit": self.unit,
-                "passed": self.passed}
+        d = {"name": self.name, "where": self.where, "value": round(float(self.value), 4),
+             "limit": self.limit, "sense": self.sense, "unit": self.unit,
+             "passed": self.passed}
+        if self.detail:
+            d["detail"] = self.detail
+        return d
 
     def text(self) -> str:
         """The check with its place, for a failure list."""
         # a unit written as a word (N mm) stands apart from its number; ° and x do not
         u = f" {self.unit}" if self.unit[:1].isalpha() and self.unit != "x" else self.unit
-        return (f"{self.name} at {self.where}: {self.value:.4g}{u} "
+        text = (f"{self.name} at {self.where}: {self.value:.4g}{u} "
                 f"(limit {self.sense} {self.limit:g}{u})")
+        return f"{text}: {self.detail}" if self.detail else text
 
     def __str__(self) -> str:
         """The check and its verdict without its place (the threshold toolkit's reports name

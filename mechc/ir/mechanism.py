@@ -249,6 +249,7 @@ class SynthContext:
     density: float = 2.7e-6  # kg/mm^3 (aluminium)
     damping_ratio: float = 0.4
     overtravel: float = 0.02  # fraction of stroke a bar may pass its working range (a stop)
+    clearance: float = 1.0  # mm between parts on one plane in every state (interference)
 
     @property
     def bar(self) -> float:

@@ -8,6 +8,7 @@ importing each other.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Protocol
 
 import numpy as np
 
@@ -57,3 +58,21 @@ def cos_sin(th) -> tuple[np.ndarray, np.ndarray]:
     t2 = t * t
     q = 1.0 / (1.0 + t2)
     return (1.0 - t2) * q, (t + t) * q
+
+
+class PoseSink(Protocol):
+    """A running measure fed chunk by chunk with the poses a sweep solves (the design checks'
+    ``CheckStats``, the interference check)."""
+
+    def add(self, poses: Poses) -> None: ...
+
+
+class PoseTee:
+    """Feeds each chunk of poses to several running measures (a sweep takes one)."""
+
+    def __init__(self, *measures: PoseSink):
+        self.measures = measures
+
+    def add(self, poses: Poses) -> None:
+        for m in self.measures:
+            m.add(poses)

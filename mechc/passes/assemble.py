@@ -28,12 +28,13 @@ class MechOptions:
     stroke: float = 20.0
     actuator_force: float = 100.0  # N, rated force of each input actuator
     output_load: float = 0.5  # N, what each circuit output must move, either way
+    clearance: float = 1.0  # mm, least gap between parts on one plane (a design rule)
 
 
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                          opts: MechOptions | None = None) -> Mechanism:
     opts = opts or MechOptions()
-    ctx = SynthContext(stroke=opts.stroke)
+    ctx = SynthContext(stroke=opts.stroke, clearance=opts.clearance)
     S, w = ctx.stroke, ctx.bar
     order = [c.id for c in nl.topo_cells()]
     cells = {c.id: c for c in nl.cells.values()}

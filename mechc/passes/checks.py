@@ -8,8 +8,9 @@ what its net needs, a force budget that would not converge), each placed cell's 
 transmission angle over every sampled state (rest and along single-input motions), distance from
 singular (toggle) configurations, states the closed forms could not solve (parts that cannot
 assemble, a pin off the end of its slot, a slider jammed between contradictory limits), spring force
-at its weakest against what it must move, and for a sequential design each MEMORY's SET and RESET
-never pressing together.
+at its weakest against what it must move, for a sequential design each MEMORY's SET and RESET
+never pressing together, and on the same states that no two parts on one plane come closer than
+the clearance (``mechc.physics.interference``).
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from __future__ import annotations
 from mechc.cells.library import Library
 from mechc.ir.check import Check
 from mechc.ir.design import Design
+from mechc.parts.poses import PoseTee
+from mechc.physics.interference import Interference
 from mechc.physics.measures import CheckStats
 from mechc.proofs.kinematic import sweep
 from mechc.proofs.seq_mechanism import prove_sequential_kinematic
@@ -27,20 +30,24 @@ def run_design_checks(design: Design, lib: Library) -> None:
     single-input change up to 10 inputs) and record them in the mechanism and the stats."""
     mech = design.mechanism
     stats = CheckStats(mech)
+    parts = Interference(mech, mech.ctx.clearance)
+    both = PoseTee(stats, parts)  # one sweep feeds both
     wide = len(design.netlist.inputs) > 10
     # a budget of cell-states, so a big design is checked on a sample (the kinematic proof,
     # `mechc simulate --level kinematic`, remains exhaustive up to 10 inputs)
     budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
-    sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
+    sweep(design, lib, samples=5 if wide else 11, stats=both, sample=128, max_states=budget)
     measured = stats.checks()
     if design.sequential is not None:
-        measured += _memory_checks(design, lib, stats)
+        measured += _memory_checks(design, lib, both)
+    measured += parts.checks()
     mech.checks = mech.synthesis_checks() + cell_checks(design, lib) + measured
     failed = [c for c in mech.checks if not c.passed]
     mus = [c.value for c in mech.checks if c.name == "transmission angle"]
     design.stats["design_checks"] = {
         "passed": not failed, "count": len(mech.checks), "failed": [c.text() for c in failed],
         "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
+        "interference": parts.summary(),
     }
 
 
@@ -54,7 +61,7 @@ def cell_checks(design: Design, lib: Library) -> list[Check]:
     return out
 
 
-def _memory_checks(design: Design, lib: Library, stats: CheckStats) -> list[Check]:
+def _memory_checks(design: Design, lib: Library, stats: PoseTee) -> list[Check]:
     """A sequential design is also walked through every specified transition (the kinematic
     sequential proof): each MEMORY's SET and RESET must never press its lever together."""
     r = prove_sequential_kinematic(design, design.spec, lib, random_walks=0, stats=stats)

@@ -40,7 +40,7 @@ from mechc.physics.closed_form import Poses
 from mechc.physics.evaluate import CellModels, output_signals, settle
 
 # FAR and N are part of this module's interface (cells' build_dynamics use them)
-__all__ = ["FAR", "MOVE_SAMPLES", "N", "DynSettings", "MoveResult", "PoseSink", "Scene",
+__all__ = ["FAR", "MOVE_SAMPLES", "N", "DynSettings", "MoveResult", "FrameSink", "Scene",
            "min_jerk"]
 
 MOVE_SAMPLES = 41  # closed-form samples along an input move (boundary drive and reference)
@@ -84,7 +84,7 @@ class MoveResult:
     watched: dict[str, np.ndarray] = field(default_factory=dict)  # Scene.watch sliders' u (mm)
 
 
-class PoseSink(Protocol):
+class FrameSink(Protocol):
     """What receives every body's pose while a move runs (a trace, ``mechc.proofs.trace``):
     ``sample`` is called before the first step, every ``every`` seconds of simulated time and
     after the last step; it reads the poses with :meth:`Scene.frames`."""
@@ -127,7 +127,7 @@ class Scene:
     state: dict[str, float] = field(default_factory=dict)  # current input values
     mem_state: dict[str, float] = field(default_factory=dict)  # stateful cells (MEMORY)
     watch: list[str] = field(default_factory=list)  # slider bodies whose u each move records
-    sink: PoseSink | None = None  # receives every body's pose while a move runs (a trace)
+    sink: FrameSink | None = None  # receives every body's pose while a move runs (a trace)
 
     # ---- building ---------------------------------------------------------------------------
     @staticmethod

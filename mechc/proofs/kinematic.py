@@ -20,6 +20,7 @@ from mechc.errors import UsageError
 from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
+from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError, Poses
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.physics.measures import CheckStats
@@ -34,7 +35,7 @@ MAX_LISTED = 50
 
 
 def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
-          inputs_order: list[str] | None = None, stats: CheckStats | None = None,
+          inputs_order: list[str] | None = None, stats: PoseSink | None = None,
           budget: int = 20_000_000, sample: int = 512, max_states: int | None = None,
           on_poses: Callable[[Poses, int], None] | None = None):
     """Evaluate rest states and single-input changes (``samples`` points along the moving

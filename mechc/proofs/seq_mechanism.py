@@ -22,9 +22,9 @@ from mechc.cells.library import Library
 from mechc.errors import UsageError
 from mechc.ir.design import Design
 from mechc.ir.seqspec import SeqSpec
+from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
-from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, Scene
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
@@ -103,7 +103,7 @@ def sequential_kinematic_engine(design: Design, spec: SeqSpec, lib: Library,
 
 def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float = 0.05,
                                samples: int = 21, seed: int = 0, random_walks: int = 4,
-                               stats: CheckStats | None = None,
+                               stats: PoseSink | None = None,
                                trace: TraceRecorder | None = None) -> ProofReport:
     """Walk the closed form through the spec's sequences (each step sampled along the moving
     input, the stateful cells settled at every sample); ``trace`` receives every body's pose
@@ -117,7 +117,7 @@ def prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: fl
 
 def _prove_sequential_kinematic(design: Design, spec, lib: Library, tolerance: float,
                                 samples: int, seed: int, random_walks: int,
-                                stats: CheckStats | None,
+                                stats: PoseSink | None,
                                 trace: TraceRecorder | None) -> ProofReport:
     t0 = time.perf_counter()
     mech, types = design.mechanism, _types(design)

@@ -2,7 +2,7 @@
 
 A :class:`TraceRecorder` is handed to a proof through ``ProofSettings.trace``; the engines
 feed it where their poses are — the closed form's ``Poses`` (kinematic level) and the pymunk
-scene's bodies (dynamic level, as the scene's ``PoseSink``) — and :meth:`TraceRecorder.to_json`
+scene's bodies (dynamic level, as the scene's ``FrameSink``) — and :meth:`TraceRecorder.to_json`
 gives the document ``mechc/schema/trace.schema.json`` describes (docs/trace.md). Nothing is
 recorded unless a recorder is given.
 
@@ -61,7 +61,7 @@ class TraceRecorder:
         self.mech = mech
         self.max_poses = max_poses
         self.poses = 0  # body poses recorded so far
-        self.every = every  # dynamic level: s between samples (the scene's PoseSink)
+        self.every = every  # dynamic level: s between samples (the scene's FrameSink)
         self.move_time = move_time  # kinematic level: nominal s for a whole change
         self.owner: dict[str, str] = {}
         bodies: list[Body] = []
@@ -168,7 +168,7 @@ class TraceRecorder:
                       "t": [], "frac": [], "frames": []}
 
     def sample(self, scene: Scene, t: float, frac: float) -> None:
-        """Every body's pose in ``scene`` now (the scene's ``PoseSink``); a body the scene
+        """Every body's pose in ``scene`` now (the scene's ``FrameSink``); a body the scene
         does not hold is NaN."""
         if self._open is None:
             return
