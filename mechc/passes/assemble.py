@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from mechc.cells.builder import Builder, rect
 from mechc.cells.library import Library
+from mechc.cells.materials import DEFAULT_MATERIAL, material
 from mechc.errors import DesignError
 from mechc.geometry.transform import bounds, translate
 from mechc.ir.check import Check
@@ -28,12 +29,14 @@ class MechOptions:
     stroke: float = 20.0
     actuator_force: float = 100.0  # N, rated force of each input actuator
     output_load: float = 0.5  # N, what each circuit output must move, either way
+    material: str = DEFAULT_MATERIAL  # plate material (mechc/cells/materials.py)
 
 
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                          opts: MechOptions | None = None) -> Mechanism:
     opts = opts or MechOptions()
-    ctx = SynthContext(stroke=opts.stroke)
+    mat = material(opts.material)
+    ctx = SynthContext(stroke=opts.stroke, density=mat.density, material=mat.name)
     S, w = ctx.stroke, ctx.bar
     order = [c.id for c in nl.topo_cells()]
     cells = {c.id: c for c in nl.cells.values()}

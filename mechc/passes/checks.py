@@ -14,9 +14,14 @@ never pressing together.
 
 from __future__ import annotations
 
+import numpy as np
+
+from mechc.cells.cell import Cell
 from mechc.cells.library import Library
 from mechc.ir.check import Check
 from mechc.ir.design import Design
+from mechc.passes.strength import strength_checks
+from mechc.physics.evaluate import settle
 from mechc.physics.measures import CheckStats
 from mechc.proofs.kinematic import sweep
 from mechc.proofs.seq_mechanism import prove_sequential_kinematic
@@ -31,11 +36,14 @@ def run_design_checks(design: Design, lib: Library) -> None:
     # a budget of cell-states, so a big design is checked on a sample (the kinematic proof,
     # `mechc simulate --level kinematic`, remains exhaustive up to 10 inputs)
     budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
-    sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128, max_states=budget)
+    result = sweep(design, lib, samples=5 if wide else 11, stats=stats, sample=128,
+                   max_states=budget)
     measured = stats.checks()
     if design.sequential is not None:
         measured += _memory_checks(design, lib, stats)
-    mech.checks = mech.synthesis_checks() + cell_checks(design, lib) + measured
+    mech.checks = (mech.synthesis_checks() + cell_checks(design, lib)
+                   + rest_checks(design, lib, result["rest_bits"]) + measured
+                   + strength_checks(design))
     failed = [c for c in mech.checks if not c.passed]
     mus = [c.value for c in mech.checks if c.name == "transmission angle"]
     design.stats["design_checks"] = {
@@ -51,6 +59,22 @@ def cell_checks(design: Design, lib: Library) -> list[Check]:
     for cid in mech.order:
         cls = lib[design.netlist.cells[cid].cell]
         out += cls.checks(cid, mech.cells[cid], mech.ctx)
+    return out
+
+
+def rest_checks(design: Design, lib: Library, rest_bits: np.ndarray) -> list[Check]:
+    """Each placed cell's rules on the rest states (``Cell.rest_checks``): every input vector
+    the sweep took, MEMORY cells settled from their initial states."""
+    mech = design.mechanism
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    names = list(design.netlist.inputs)
+    if all(lib[t].rest_checks.__func__ is Cell.rest_checks.__func__ for t in set(types.values())):
+        return []  # no cell of this design has rest rules: skip the evaluation
+    poses, _, _ = settle(mech, lib, types, {nm: rest_bits[k].astype(float)
+                                            for k, nm in enumerate(names)})
+    out: list[Check] = []
+    for cid in mech.order:
+        out += lib[types[cid]].rest_checks(cid, mech.cells[cid], mech.ctx, poses)
     return out
 
 
