@@ -45,7 +45,7 @@ def sorter():
 def test_euler_load_of_a_rod_by_hand(sorter):
     """Every rod's buckling check is pi^2 E I / L^2 over its load, I = b h^3 / 12 about the
     plate's thickness (aluminium 6061-T6: E = 68.9 GPa; 6 x 3 mm bars at the default stroke)."""
-    rods = {r.id: r for r in push_rods(sorter)}
+    rods = {r.id: r for r in push_rods(sorter.mechanism)}
     checks = {c.where: c for c in checks_named(sorter, "rod buckling")}
     assert checks and set(checks) <= set(rods)
     joint = next(j for j in sorter.mechanism.nets["A"].joints if j.id == "net.A.rod2")
@@ -74,6 +74,20 @@ def test_axial_stress_and_pins_by_hand(sorter):
     assert b.value == pytest.approx(f / 9.0)
     rod = sorter.mechanism.nets["A"].joints[0]
     assert rod.pin_diameter == 3.0 and '"pin_diameter_mm": 3.0' in json.dumps(rod.to_json())
+
+
+def test_lever_bending_by_hand(sorter):
+    """A NOT lever of arm 1.5 x stroke = 30 mm under its cell's load F (the largest demand of
+    the nets it drives or loads, or its own output demand): sigma = M / Z = F 30 / (3 x 6^2 / 6)."""
+    mech = sorter.mechanism
+    (c,) = [c for c in checks_named(sorter, "lever bending") if c.where == "c5.lever"]
+    nets = [n for n in mech.nets.values()
+            if n.data["driver"] == "c5" or any(x.startswith("c5.") for x in n.data["loads"])]
+    loads = [max(n.data["demand"]["right_N"], n.data["demand"]["left_N"]) for n in nets]
+    own = mech.cells["c5"].data["output_demand"]
+    f = max(loads + [own["right_N"], own["left_N"]])
+    assert c.value == pytest.approx(f * 30.0 / (3.0 * 6.0 ** 2 / 6.0), rel=1e-9)
+    assert "30 mm arm" in c.name and c.limit == pytest.approx(138.0)
 
 
 def test_spring_design_by_hand(sorter):
@@ -109,14 +123,15 @@ def test_spring_design_by_hand(sorter):
 
 
 def test_a_slender_rod_is_rejected_by_name(sorter):
-    """A rod made 10x longer buckles: its check fails and names it; the others are unchanged."""
+    """A rod made 10x longer after sizing (its guides as they were: none) buckles: its check
+    fails and names it; the others are unchanged."""
     design = dataclasses.replace(sorter)
-    before = {c.where: c for c in strength_checks(design) if "buckling" in c.name}
+    before = {c.where: c for c in strength_checks(design.mechanism) if "buckling" in c.name}
     rod = design.mechanism.nets["A"].joints[1]  # 449 mm, the longest
     length = rod.length
     try:
         rod.length = 10 * length
-        after = {c.where: c for c in strength_checks(design) if "buckling" in c.name}
+        after = {c.where: c for c in strength_checks(design.mechanism) if "buckling" in c.name}
     finally:
         rod.length = length
     assert before[rod.id].passed and not after[rod.id].passed
@@ -124,14 +139,31 @@ def test_a_slender_rod_is_rejected_by_name(sorter):
     assert [w for w, c in after.items() if not c.passed] == [rod.id]
 
 
-def test_pla_rods_buckle_by_name(cli, tmp_path):
-    """3D-printed PLA (E = 2.35 GPa) under the default loads: the long rods of the sorter
-    buckle; compile exits 1 naming them, and the file written reloads in simulate."""
+def test_long_pla_rods_get_guides_by_hand(cli, tmp_path):
+    """3D-printed PLA (E = 2346.5 MPa) under the default loads: three long rods of the sorter
+    would buckle pin to pin; each gets the fewest guides that keep every span within its Euler
+    length at a factor 3 (by hand: spans = ceil(L / (pi sqrt(E I / (3 P))))), compile passes,
+    and the file reloads in simulate."""
     out = tmp_path / "pla.json"
     rc, _, err = cli("compile", SORTER, "-o", out, "--material", "pla")
-    assert rc == 1 and "rod buckling" in err and "net.A.rod2" in err
-    assert json.loads(out.read_text())["mechanism"]["rules"]["material"] == "pla"
-    rc, outp, err = cli("simulate", out, "--level", "logic")
+    assert rc == 0, err
+    d = json.loads(out.read_text())
+    assert d["mechanism"]["rules"]["material"] == "pla"
+    guided = {}
+    for name, net in d["mechanism"]["nets"].items():
+        for j, load in zip(net["joints"], net["data"]["loads"]):
+            cell = next(c for c in d["cells"] if c["id"] == load.split(".")[0])
+            ask = cell["geometry"]["data"]["input_loads"][load.split(".")[1]]
+            p = (ask["right_N"] if j["pb"][0] >= j["pa"][0] else ask["left_N"]) + 0.02
+            l_max = math.pi * math.sqrt(2346.5 * 13.5 / (3 * p))
+            spans = math.ceil(j["length_mm"] / l_max)
+            if spans > 1:
+                guided[j["id"]] = spans - 1
+            assert net["data"].get("rod_guides", {}).get(j["id"], 0) == spans - 1, j["id"]
+    assert guided == {"net.A.rod2": 2, "net.B.rod1": 2, "net.n1.rod1": 1}
+    checks = {c["where"]: c for c in d["mechanism"]["checks"] if "buckling" in c["name"]}
+    assert "2 guides: span 149.6 mm" in checks["net.A.rod2"]["name"]
+    rc, _, err = cli("simulate", out, "--level", "logic")
     assert rc == 0, err
 
 

@@ -22,6 +22,7 @@ from mechc.ir.check import Check
 from mechc.ir.layout import Layout
 from mechc.ir.mechanism import Demand, Joint, Mechanism, Part, Point, SynthContext, Terminal
 from mechc.ir.netlist import Netlist
+from mechc.passes.strength import size_parts
 
 
 @dataclass
@@ -169,7 +170,9 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                            "required_left_N": round(d.left + ctx.friction, 4)}
         checks.append(Check("actuator force", f"input {name}", opts.actuator_force / need,
                             1.0, ">=", "x"))
-    return Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
+    mech = Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
+    size_parts(mech)  # pins and rod guides from the loads just budgeted
+    return mech
 
 
 def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):

@@ -43,7 +43,7 @@ def run_design_checks(design: Design, lib: Library) -> None:
         measured += _memory_checks(design, lib, stats)
     mech.checks = (mech.synthesis_checks() + cell_checks(design, lib)
                    + rest_checks(design, lib, result["rest_bits"]) + measured
-                   + strength_checks(design))
+                   + strength_checks(mech))
     failed = [c for c in mech.checks if not c.passed]
     mus = [c.value for c in mech.checks if c.name == "transmission angle"]
     design.stats["design_checks"] = {
@@ -62,16 +62,28 @@ def cell_checks(design: Design, lib: Library) -> list[Check]:
     return out
 
 
+#: Up to this many MEMORY cells, rest states start from every combination of their states.
+REST_MEMORY_COMBINATIONS = 4
+
+
 def rest_checks(design: Design, lib: Library, rest_bits: np.ndarray) -> list[Check]:
     """Each placed cell's rules on the rest states (``Cell.rest_checks``): every input vector
-    the sweep took, MEMORY cells settled from their initial states."""
+    the sweep took, MEMORY cells settled from each combination of their states (from their
+    initial states only beyond ``REST_MEMORY_COMBINATIONS`` memories)."""
     mech = design.mechanism
     types = {c.id: c.cell for c in design.netlist.cells.values()}
     names = list(design.netlist.inputs)
     if all(lib[t].rest_checks.__func__ is Cell.rest_checks.__func__ for t in set(types.values())):
         return []  # no cell of this design has rest rules: skip the evaluation
-    poses, _, _ = settle(mech, lib, types, {nm: rest_bits[k].astype(float)
-                                            for k, nm in enumerate(names)})
+    mems = [cid for cid in mech.order if getattr(lib[types[cid]], "stateful", False)]
+    starts = 1 << len(mems) if len(mems) <= REST_MEMORY_COMBINATIONS else 1
+    n = rest_bits.shape[1]
+    values = {nm: np.tile(rest_bits[k].astype(float), starts) for k, nm in enumerate(names)}
+    state = None
+    if starts > 1:
+        combo = np.repeat(np.arange(starts), n)
+        state = {cid: ((combo >> i) & 1).astype(float) for i, cid in enumerate(mems)}
+    poses, _, _ = settle(mech, lib, types, values, state)
     out: list[Check] = []
     for cid in mech.order:
         out += lib[types[cid]].rest_checks(cid, mech.cells[cid], mech.ctx, poses)
