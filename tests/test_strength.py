@@ -150,7 +150,7 @@ def test_long_pla_rods_get_guides_by_hand(cli, tmp_path):
     d = json.loads(out.read_text())
     assert d["mechanism"]["rules"]["material"] == "pla"
     guided = {}
-    for name, net in d["mechanism"]["nets"].items():
+    for net in d["mechanism"]["nets"].values():
         for j, load in zip(net["joints"], net["data"]["loads"]):
             cell = next(c for c in d["cells"] if c["id"] == load.split(".")[0])
             ask = cell["geometry"]["data"]["input_loads"][load.split(".")[1]]
