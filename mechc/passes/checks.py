@@ -9,7 +9,8 @@ transmission angle over every sampled state (rest and along single-input motions
 singular (toggle) configurations, states the closed forms could not solve (parts that cannot
 assemble, a pin off the end of its slot, a slider jammed between contradictory limits), spring force
 at its weakest against what it must move, and for a sequential design each MEMORY's SET and RESET
-never pressing together.
+never pressing together; each cell's rules on the rest states (``Cell.rest_checks``); and the
+strength of every part (``mechc/passes/strength.py``: stress, bending, buckling, pins, springs).
 """
 
 from __future__ import annotations
