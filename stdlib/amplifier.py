@@ -41,6 +41,7 @@ from scipy.optimize import brentq
 
 from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
+from mechc.cells.springs import design_coil
 from mechc.errors import DesignError
 from mechc.ir.check import Check
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Part, Point, Spring, SynthContext
@@ -177,6 +178,22 @@ def check_landing(d: AmpDesign, where: str = "amplifier") -> list[Check]:
     # the 1e-9 lets a dashpot sized for exactly MAX_LANDING_RATIO pass despite rounding
     return [Check("toggle landing on a stop with its dashpot / driven speed", where, ratio,
                   MAX_LANDING_RATIO * (1 + 1e-9), "<=", "x")]
+
+
+def rest_shortfall(part: Part, poses) -> float:
+    """How far (mm) the input slider rests short of its nearer end, at worst over the states of
+    ``poses`` (NaN where unsolved counts as not reaching)."""
+    d = part.data["design"]
+    slider = next(b for b in part.bodies if b.role == "input A")
+    u = np.asarray(poses.u[slider.id], dtype=float)
+    short = d["stroke"] / 2 - np.abs(u)
+    return float(np.nanmax(np.where(np.isfinite(short), short, np.inf))) if short.size else 0.0
+
+
+def check_rest(part: Part, poses, where: str) -> list[Check]:
+    """The design check on the input's rest positions: short of its end by at most engage."""
+    return [Check("input at rest short of its end (the wedge engages within)", where,
+                  rest_shortfall(part, poses), part.data["design"]["engage"], "<=", "mm")]
 
 
 def design(ctx: SynthContext, demand: Demand, params: dict | None = None) -> AmpDesign:
@@ -412,8 +429,11 @@ class Amplifier(Cell):
             anchor = (xd + sense * 0.5 * S, y)
             rest = 0.5 * S + d.press / d.press_rate
             damping = 2 * ctx.damping_ratio * math.sqrt(d.press_rate * 1000.0 * m) / 1000.0
+            # heaviest with F pushed to the far end of its slot (a compression spring)
+            f_max = d.press + d.press_rate * d.slot
             b.part.springs.append(Spring(b._id("press"), slider, fid, anchor, (xd, y),
-                                         d.press_rate, rest, damping, d.press))
+                                         d.press_rate, rest, damping, d.press, f_max,
+                                         design_coil(d.press_rate, f_max, "compression")))
         # ---- powered rollers ---------------------------------------------------------------
         r1c = (x_w1 + (d.r_f + d.r_r) * sg, y + (d.r_f + d.r_r) * cg)
         r2c = (x_w2 - (d.r_f + d.r_r) * sg, y + (d.r_f + d.r_r) * cg)
@@ -453,8 +473,10 @@ class Amplifier(Cell):
         i_t = b.part.body(t_id).mass * (0.5 * d.rc) ** 2
         omega = math.sqrt(d.toggle_rate * 1000.0 * (d.toggle_e ** 2) / i_t)
         damping = d.toggle_damping * 2 * i_t * omega / d.toggle_e ** 2 / 1000.0
+        f_max = d.toggle_rate * (d.toggle_e + d.toggle_g - d.toggle_rest)  # at dead centre
         b.part.springs.append(Spring(b._id("toggle"), GROUND, t_id, G, E, d.toggle_rate,
-                                     d.toggle_rest, damping, d.hold_torque))
+                                     d.toggle_rest, damping, d.hold_torque, f_max,
+                                     design_coil(d.toggle_rate, f_max)))
         # ---- output: rod from the crank pin to the output slider ---------------------------
         x_pin = pin[0] + d.rod
         out = b.slider("out", x_pin - w / 2, x_pin + 0.8 * S, pin[1], "AMPLIFIER output")
@@ -477,6 +499,14 @@ class Amplifier(Cell):
     def checks(cls, cid: str, part: Part, ctx: SynthContext) -> list[Check]:
         """The landing rule on the design recorded in ``part.data``."""
         return check_landing(AmpDesign(**part.data["design"]), f"amplifier {cid}")
+
+    @classmethod
+    def rest_checks(cls, cid: str, part: Part, ctx: SynthContext, poses) -> list[Check]:
+        """The input must come to rest within ``engage`` of its end in every rest state: F1
+        meets its wedge when the input is ``engage`` short of on, F2 when it is that short of
+        off, and an input resting farther short (still within the 5 % rest tolerance of the
+        proofs) leaves the wedge open and the toggle where it was."""
+        return check_rest(part, poses, f"amplifier {cid}")
 
     @classmethod
     def build_dynamics(cls, scene, part: Part) -> None:

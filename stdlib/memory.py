@@ -20,6 +20,7 @@ import numpy as np
 
 from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
+from mechc.cells.springs import design_coil
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Spring
 from mechc.parts.rod import slider_from_rod
 from mechc.physics.closed_form import KinematicsError, Poses
@@ -98,9 +99,11 @@ class Memory(Cell):
         D, G = (xo, -a - rd), (xo, -a - g)
         mass = ctx.mass([poly])
         omega = math.sqrt(k * 1000.0 * max(rd, 1.0) ** 2 / max(mass * a * a, 1e-9))
+        f_max = k * (rest - (g - rd))  # most compressed with the lever upright
         b.part.springs.append(Spring(b._id("detent"), GROUND, lever, G, D, k, rest,
                                      2 * ctx.damping_ratio * mass * omega / 1000.0,
-                                     preload=k * (rest - (g - rd))))
+                                     preload=f_max, max_force=f_max,
+                                     coil=design_coil(k, f_max, "compression")))
         tau_peak = cls.torque(np.linspace(0, alpha, 200), k, rest, d).max()
         b.part.data.update({
             "alpha_deg": round(math.degrees(alpha), 4), "hold_torque_Nmm":

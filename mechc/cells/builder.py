@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from mechc.cells.springs import design_coil
 from mechc.ir.mechanism import (
     GROUND,
     Body,
@@ -126,8 +127,10 @@ class Builder:
         anchor = (x_light + direction * d_light, at[1])
         omega = math.sqrt(k * 1000.0 / max(mass, 1e-6))  # rad/s (k in N/m)
         damping = 2 * c.damping_ratio * mass * omega / 1000.0  # N s / mm
+        # heaviest: a full stroke from the lightest position, and the over-travel past it
+        f_max = preload + k * S * (1 + c.overtravel)
         self.part.springs.append(Spring(self._id("spring"), GROUND, body, anchor, at, k, rest,
-                                        damping, preload))
+                                        damping, preload, f_max, design_coil(k, f_max)))
 
     def terminal(self, pin: str, body: str, point: Point) -> None:
         S = self.ctx.stroke

@@ -88,6 +88,13 @@ class Cell:
         return []
 
     @classmethod
+    def rest_checks(cls, cid: str, part: Part, ctx: SynthContext, poses) -> list[Check]:
+        """The cell's own rules on its placed instance at rest: ``poses`` (a
+        ``mechc.parts.poses.Poses``) holds every body's coordinates in every rest state of the
+        whole mechanism (every input vector the design checks take). The default has none."""
+        return []
+
+    @classmethod
     def kinematics(cls, part: Part, fixed: dict[str, np.ndarray], size: int, extra=None):
         """Poses of every body given the input terminal bodies' displacements (closed form)."""
         return solve(part, fixed, size, extra)

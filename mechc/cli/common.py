@@ -8,12 +8,15 @@ import os
 from pathlib import Path
 
 from mechc.backends.design_json import check_writable, design_from_json, load_design_json
+from mechc.cells.materials import DEFAULT_MATERIAL, MATERIALS
 from mechc.errors import UsageError
 from mechc.frontends import load_spec
 from mechc.ir.design import Design
+from mechc.ir.mechanism import SynthContext
 from mechc.passes.assemble import MechOptions
 from mechc.passes.map import MapOptions
 from mechc.passes.minimise import MinimiseOptions
+from mechc.passes.strength import force_ceiling
 from mechc.pipeline import CompileOptions, compile_sequential, compile_spec
 from mechc.ui import finite_float, int_at_least
 
@@ -56,6 +59,11 @@ def compile_options(c: argparse.ArgumentParser) -> None:
     m.add_argument("--clearance", type=finite_float, default=1.0, metavar="MM",
                    help="least gap between two parts on one plane in any state the design "
                    "checks visit; closer fails the interference check (default: %(default)s mm)")
+    m.add_argument("--material", default=DEFAULT_MATERIAL, metavar="NAME",
+                   help="plate material of bars, sliders, levers and rods: "
+                   + ", ".join(f"{k} ({v.title})" for k, v in MATERIALS.items())
+                   + " (default: %(default)s; springs are music wire and pins steel whatever "
+                   "the plate)")
     m.add_argument("--no-amplify", action="store_true",
                    help="never insert AMPLIFIER cells by itself (by default they go where an "
                    "actuator or a MEMORY loop is short of force, and before a sequential output "
@@ -73,6 +81,7 @@ def options_from_args(args: argparse.Namespace) -> CompileOptions:
         raise UsageError("--actuator-force must be positive and --output-load not negative")
     if not 0.0 <= args.clearance <= 100.0:
         raise UsageError("--clearance must be between 0 and 100 mm")
+    check_forces(args)
     return CompileOptions(
         minimise=MinimiseOptions(time_limit=args.time_limit, share=not args.no_share,
                                  complements=args.phase == "auto",
@@ -82,11 +91,34 @@ def options_from_args(args: argparse.Namespace) -> CompileOptions:
                        prefer=tuple(getattr(args, "use_cell", ())),
                        target=getattr(args, "map_target", "conventional")),
         mech=MechOptions(stroke=args.stroke, actuator_force=args.actuator_force,
-                         output_load=args.output_load, clearance=args.clearance),
+                         output_load=args.output_load, clearance=args.clearance,
+                         material=getattr(args, "material", DEFAULT_MATERIAL)),
         cell_dirs=tuple(args.cell_dirs),
         amplify=not getattr(args, "no_amplify", False),
         timings=getattr(args, "timings", False),
     )
+
+
+def check_forces(args: argparse.Namespace) -> None:
+    """The material is known, and no force option asks more than one bar of it carries at
+    yield (or, brittle, at break) with no safety factor at all: such a design could not be
+    made of that plate whatever its layout, so it is refused (exit 2) before any work. Loads
+    below that but above what the safety factors allow compile, and the strength checks fail
+    (exit 1) naming the parts."""
+    name = getattr(args, "material", DEFAULT_MATERIAL)
+    if name not in MATERIALS:
+        raise UsageError(f"--material {name!r} is not a known material; known: "
+                         + ", ".join(MATERIALS))
+    ctx = SynthContext(stroke=args.stroke, material=name)
+    ceiling = force_ceiling(ctx)
+    for opt, v in (("--output-load", args.output_load), ("--actuator-force", args.actuator_force)):
+        if v > ceiling:
+            raise UsageError(
+                f"refusing to compile: {opt} {v:g} N is more than a {ctx.bar:g} x "
+                f"{ctx.thickness:g} mm bar of {MATERIALS[name].title} carries at "
+                f"{'break' if MATERIALS[name].brittle else 'yield'} ({ceiling:.4g} N, with no "
+                f"safety factor); no design of that plate can carry it (a larger --stroke "
+                f"widens the bars, or choose another --material)")
 
 
 def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = True) -> Design:

@@ -38,6 +38,7 @@ class Body:
     role: str = ""
     poly_layers: list[int] | None = None  # per polygon, where pieces sit on other planes
     speed: float | None = None  # rotor: rad/s, counter-clockwise positive
+    pin_diameter: float | None = None  # lever, rotor: mm, the pin of its fixed pivot
 
     def layer_of(self, i: int) -> int:
         return self.poly_layers[i] if self.poly_layers else self.layer
@@ -54,6 +55,8 @@ class Body:
             d["pivot"] = _r(self.pivot)
         if self.speed is not None:
             d["speed_rad_s"] = round(self.speed, 6)
+        if self.pin_diameter is not None:
+            d["pin_diameter_mm"] = round(self.pin_diameter, 4)
         return d
 
     @staticmethod
@@ -62,7 +65,9 @@ class Body:
                     float(d["mass_kg"]), _pt(d["axis"]) if d.get("axis") else None,
                     _pt(d["pivot"]) if d.get("pivot") else None, int(d.get("layer", 0)),
                     d.get("role", ""), d.get("poly_layers"),
-                    float(d["speed_rad_s"]) if d.get("speed_rad_s") is not None else None)
+                    float(d["speed_rad_s"]) if d.get("speed_rad_s") is not None else None,
+                    float(d["pin_diameter_mm"]) if d.get("pin_diameter_mm") is not None
+                    else None)
 
 
 @dataclass
@@ -79,6 +84,9 @@ class Joint:
       a circle of ``radius_a`` about ``pa``; on b, a roller of radius ``length`` about ``q``.
       Used where the contact point travels (cams, friction rollers); the cell that owns it
       supplies the kinematics.
+
+    ``pin_diameter``: the diameter (mm) of the pins a rod, pin or groove joint is made with
+    (sized by the strength pass, ``mechc/passes/strength.py``).
     """
 
     id: str
@@ -96,6 +104,7 @@ class Joint:
     profile: list[Point] | None = None
     radius_a: float | None = None
     friction: float | None = None
+    pin_diameter: float | None = None
 
     def to_json(self) -> dict:
         d = {"id": self.id, "kind": self.kind, "a": self.a, "b": self.b}
@@ -115,6 +124,8 @@ class Joint:
             d["normal"] = _r(self.normal, 6)
         if self.length is not None:
             d["length_mm"] = round(self.length, 4)
+        if self.pin_diameter is not None:
+            d["pin_diameter_mm"] = round(self.pin_diameter, 4)
         return d
 
     @staticmethod
@@ -126,12 +137,52 @@ class Joint:
                      d.get("driven"),
                      [_pt(p) for p in d["profile"]] if d.get("profile") else None,
                      float(d["radius_a_mm"]) if d.get("radius_a_mm") is not None else None,
-                     float(d["friction"]) if d.get("friction") is not None else None)
+                     float(d["friction"]) if d.get("friction") is not None else None,
+                     float(d["pin_diameter_mm"]) if d.get("pin_diameter_mm") is not None
+                     else None)
+
+
+@dataclass(frozen=True)
+class Coil:
+    """A helical spring as bought: music wire of diameter ``wire`` wound at mean diameter
+    ``mean_diameter`` with ``active_coils`` turns; ``stress`` is the Wahl-corrected shear stress
+    at the spring's largest force, ``allowable`` the torsional yield divided by the spring safety
+    factor (see mechc/cells/springs.py)."""
+
+    wire: float  # d, mm
+    mean_diameter: float  # D, mm
+    active_coils: float  # n
+    free_length: float  # mm, body and hooks of an extension spring
+    max_force: float  # N, the largest force it works at (preload + rate x travel)
+    stress: float  # MPa at max_force
+    allowable: float  # MPa
+    kind: str = "extension"  # or "compression"
+
+    @property
+    def index(self) -> float:
+        return self.mean_diameter / self.wire
+
+    def to_json(self) -> dict:
+        return {"wire_mm": round(self.wire, 4), "mean_diameter_mm": round(self.mean_diameter, 4),
+                "index": round(self.index, 4), "active_coils": round(self.active_coils, 3),
+                "free_length_mm": round(self.free_length, 3),
+                "max_force_N": round(self.max_force, 4), "stress_MPa": round(self.stress, 3),
+                "allowable_MPa": round(self.allowable, 3), "kind": self.kind,
+                "wire": "music wire ASTM A228"}
+
+    @staticmethod
+    def from_json(d: dict) -> Coil:
+        return Coil(float(d["wire_mm"]), float(d["mean_diameter_mm"]), float(d["active_coils"]),
+                    float(d["free_length_mm"]), float(d["max_force_N"]), float(d["stress_MPa"]),
+                    float(d["allowable_MPa"]), d.get("kind", "extension"))
 
 
 @dataclass
 class Spring:
-    """A linear spring between ``pa`` on a and ``pb`` on b (tension if stretched past rest)."""
+    """A linear spring between ``pa`` on a and ``pb`` on b (tension if stretched past rest).
+
+    ``max_force``: the largest force it sees in its working range (preload + rate x travel), set
+    by whoever designs it; ``coil``: the wire and coils that give its rate at that force."""
 
     id: str
     a: str
@@ -142,18 +193,27 @@ class Spring:
     rest: float  # mm
     damping: float = 0.0  # N s / mm
     preload: float = 0.0  # N at the spring's lightest working position (for the report)
+    max_force: float | None = None  # N at its heaviest working position
+    coil: Coil | None = None
 
     def to_json(self) -> dict:
-        return {"id": self.id, "a": self.a, "b": self.b, "pa": _r(self.pa), "pb": _r(self.pb),
-                "rate_N_per_mm": round(self.rate, 6), "rest_length_mm": round(self.rest, 4),
-                "damping_Ns_per_mm": round(self.damping, 7),
-                "preload_N": round(self.preload, 4)}
+        d = {"id": self.id, "a": self.a, "b": self.b, "pa": _r(self.pa), "pb": _r(self.pb),
+             "rate_N_per_mm": round(self.rate, 6), "rest_length_mm": round(self.rest, 4),
+             "damping_Ns_per_mm": round(self.damping, 7),
+             "preload_N": round(self.preload, 4)}
+        if self.max_force is not None:
+            d["max_force_N"] = round(self.max_force, 4)
+        if self.coil is not None:
+            d["coil"] = self.coil.to_json()
+        return d
 
     @staticmethod
     def from_json(d: dict) -> Spring:
         return Spring(d["id"], d["a"], d["b"], _pt(d["pa"]), _pt(d["pb"]),
                       float(d["rate_N_per_mm"]), float(d["rest_length_mm"]),
-                      float(d.get("damping_Ns_per_mm", 0.0)), float(d.get("preload_N", 0.0)))
+                      float(d.get("damping_Ns_per_mm", 0.0)), float(d.get("preload_N", 0.0)),
+                      float(d["max_force_N"]) if d.get("max_force_N") is not None else None,
+                      Coil.from_json(d["coil"]) if d.get("coil") else None)
 
 
 @dataclass
@@ -246,7 +306,9 @@ class SynthContext:
     min_preload: float = 0.2  # N
     spring_range: float = 0.3  # k*S / preload: the force rises 30 % over the stroke
     thickness: float = 3.0  # mm plate
-    density: float = 2.7e-6  # kg/mm^3 (aluminium)
+    density: float = 2.7e-6  # kg/mm^3 (aluminium; the plate material's, mechc/cells/materials.py)
+    material: str = "aluminium"  # the plate material's name (--material)
+    pin_diameter: float = 3.0  # mm, the smallest pin (pivots, rod ends, slot pins) made
     damping_ratio: float = 0.4
     overtravel: float = 0.02  # fraction of stroke a bar may pass its working range (a stop)
     clearance: float = 1.0  # mm between parts on one plane in every state (interference)

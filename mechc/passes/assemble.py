@@ -15,12 +15,14 @@ from dataclasses import dataclass
 
 from mechc.cells.builder import Builder, rect
 from mechc.cells.library import Library
+from mechc.cells.materials import DEFAULT_MATERIAL, material
 from mechc.errors import DesignError
 from mechc.geometry.transform import bounds, translate
 from mechc.ir.check import Check
 from mechc.ir.layout import Layout
 from mechc.ir.mechanism import Demand, Joint, Mechanism, Part, Point, SynthContext, Terminal
 from mechc.ir.netlist import Netlist
+from mechc.passes.strength import size_parts
 
 
 @dataclass
@@ -29,12 +31,15 @@ class MechOptions:
     actuator_force: float = 100.0  # N, rated force of each input actuator
     output_load: float = 0.5  # N, what each circuit output must move, either way
     clearance: float = 1.0  # mm, least gap between parts on one plane (a design rule)
+    material: str = DEFAULT_MATERIAL  # plate material (mechc/cells/materials.py)
 
 
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                          opts: MechOptions | None = None) -> Mechanism:
     opts = opts or MechOptions()
-    ctx = SynthContext(stroke=opts.stroke, clearance=opts.clearance)
+    mat = material(opts.material)
+    ctx = SynthContext(stroke=opts.stroke, density=mat.density, material=mat.name,
+                       clearance=opts.clearance)
     S, w = ctx.stroke, ctx.bar
     order = [c.id for c in nl.topo_cells()]
     cells = {c.id: c for c in nl.cells.values()}
@@ -167,7 +172,9 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                            "required_left_N": round(d.left + ctx.friction, 4)}
         checks.append(Check("actuator force", f"input {name}", opts.actuator_force / need,
                             1.0, ">=", "x"))
-    return Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
+    mech = Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
+    size_parts(mech)  # pins and rod guides from the loads just budgeted
+    return mech
 
 
 def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):

@@ -10,15 +10,22 @@ singular (toggle) configurations, states the closed forms could not solve (parts
 assemble, a pin off the end of its slot, a slider jammed between contradictory limits), spring force
 at its weakest against what it must move, for a sequential design each MEMORY's SET and RESET
 never pressing together, and on the same states that no two parts on one plane come closer than
-the clearance (``mechc.physics.interference``).
+the clearance (``mechc.physics.interference``); each cell's rules on the rest states
+(``Cell.rest_checks``); and the strength of every part (``mechc/passes/strength.py``: stress,
+bending, buckling, pins, springs).
 """
 
 from __future__ import annotations
 
+import numpy as np
+
+from mechc.cells.cell import Cell
 from mechc.cells.library import Library
 from mechc.ir.check import Check
 from mechc.ir.design import Design
 from mechc.parts.poses import PoseTee
+from mechc.passes.strength import strength_checks
+from mechc.physics.evaluate import settle
 from mechc.physics.interference import Interference
 from mechc.physics.measures import CheckStats
 from mechc.proofs.kinematic import sweep
@@ -36,12 +43,15 @@ def run_design_checks(design: Design, lib: Library) -> None:
     # a budget of cell-states, so a big design is checked on a sample (the kinematic proof,
     # `mechc simulate --level kinematic`, remains exhaustive up to 10 inputs)
     budget = max(2000, 2_000_000 // max(1, len(design.netlist.cells)))
-    sweep(design, lib, samples=5 if wide else 11, stats=both, sample=128, max_states=budget)
+    result = sweep(design, lib, samples=5 if wide else 11, stats=both, sample=128,
+                   max_states=budget)
     measured = stats.checks()
     if design.sequential is not None:
         measured += _memory_checks(design, lib, both)
     measured += parts.checks()
-    mech.checks = mech.synthesis_checks() + cell_checks(design, lib) + measured
+    mech.checks = (mech.synthesis_checks() + cell_checks(design, lib)
+                   + rest_checks(design, lib, result["rest_bits"]) + measured
+                   + strength_checks(mech))
     failed = [c for c in mech.checks if not c.passed]
     mus = [c.value for c in mech.checks if c.name == "transmission angle"]
     design.stats["design_checks"] = {
@@ -58,6 +68,34 @@ def cell_checks(design: Design, lib: Library) -> list[Check]:
     for cid in mech.order:
         cls = lib[design.netlist.cells[cid].cell]
         out += cls.checks(cid, mech.cells[cid], mech.ctx)
+    return out
+
+
+#: Up to this many MEMORY cells, rest states start from every combination of their states.
+REST_MEMORY_COMBINATIONS = 4
+
+
+def rest_checks(design: Design, lib: Library, rest_bits: np.ndarray) -> list[Check]:
+    """Each placed cell's rules on the rest states (``Cell.rest_checks``): every input vector
+    the sweep took, MEMORY cells settled from each combination of their states (from their
+    initial states only beyond ``REST_MEMORY_COMBINATIONS`` memories)."""
+    mech = design.mechanism
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    names = list(design.netlist.inputs)
+    if all(lib[t].rest_checks.__func__ is Cell.rest_checks.__func__ for t in set(types.values())):
+        return []  # no cell of this design has rest rules: skip the evaluation
+    mems = [cid for cid in mech.order if getattr(lib[types[cid]], "stateful", False)]
+    starts = 1 << len(mems) if len(mems) <= REST_MEMORY_COMBINATIONS else 1
+    n = rest_bits.shape[1]
+    values = {nm: np.tile(rest_bits[k].astype(float), starts) for k, nm in enumerate(names)}
+    state = None
+    if starts > 1:
+        combo = np.repeat(np.arange(starts), n)
+        state = {cid: ((combo >> i) & 1).astype(float) for i, cid in enumerate(mems)}
+    poses, _, _ = settle(mech, lib, types, values, state)
+    out: list[Check] = []
+    for cid in mech.order:
+        out += lib[types[cid]].rest_checks(cid, mech.cells[cid], mech.ctx, poses)
     return out
 
 
