@@ -113,7 +113,7 @@ def find_requirements(nl: Netlist, spec: SeqSpec,
             for j, net in enumerate(sn.mem_nets):
                 sv, rv = sn.sr(t["after_a"], j)
                 if sv != 0 and rv != 0:
-                    add("set-reset-together", moving, switching or [net],
+                    add("set-reset-together", moving, [net],
                         f"SET and RESET of {net} both move when {moving} changes: the one "
                         "going off must release before the other comes on", (x, s, x2), where)
             unresolved = [net for net in sn.mem_nets if t["mem_b"][net] == X]
@@ -143,15 +143,20 @@ def _sr_pins(nl: Netlist) -> dict[str, set[str]]:
 
 
 def _path_delays(g: nx.MultiDiGraph, delay: dict[str, float], source: str,
-                 longest: bool) -> dict[str, float]:
+                 longest: bool, nexts: list[str] | None = None) -> dict[str, float]:
     """Delay from ``source`` (its own delay excluded) to the output of every node it reaches
-    in the acyclic combinational graph: the longest or the shortest sum of switching delays."""
+    in the acyclic combinational graph: the longest or the shortest sum of switching delays.
+    ``nexts``: the nodes ``source`` drives, when its edges are not in ``g`` (a MEMORY)."""
+    starts = list(g.successors(source)) if nexts is None else nexts
     best: dict[str, float] = {source: 0.0}
     pick = max if longest else min
-    for node in nx.topological_sort(g.subgraph(nx.descendants(g, source) | {source})):
-        if node == source:
-            continue
+    reach = set(starts)
+    for v in starts:
+        reach |= nx.descendants(g, v)
+    for node in nx.topological_sort(g.subgraph(reach)):
         came = [best[u] for u in g.predecessors(node) if u in best]
+        if node in starts:
+            came.append(0.0)
         if came:
             best[node] = pick(came) + delay.get(node, 0.0)
     return best
@@ -178,7 +183,8 @@ def timing_inequality(nl: Netlist, lib: Library, req: Requirement,
             continue
         reach = [near[u] for u in sr.get(cid, ()) if u in near]
         start = move_time / 2 + min(reach, default=0.0)
-        back = _path_delays(nl.graph.subgraph(set(g.nodes)), delay, cid, longest=False)
+        back = _path_delays(g, delay, cid, longest=False,
+                            nexts=sorted(set(nl.graph.successors(cid))))
         fb = [back[u] for drivers in sr.values() for u in drivers
               if u in back and u != cid]
         fb_min = min(fb, default=0.0)

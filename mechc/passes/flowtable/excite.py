@@ -92,7 +92,8 @@ def excitation(rt: ReducedTable, asg: Assignment, names: list[str],
                maps: list[dict[int, int]], fix: set[tuple[int, int, int]] = frozenset()
                ) -> Excitation:
     """``fix``: (output, column, code) whose transient value must be the destination's (a
-    repair for an output that would otherwise change twice)."""
+    repair for an output that would otherwise change twice), or the source's where the
+    destination leaves the output unspecified."""
     ft = rt.ft
     n, v = ft.n, asg.width
     size = 1 << (n + v)
@@ -126,6 +127,10 @@ def excitation(rt: ReducedTable, asg: Assignment, names: list[str],
                 for j in range(nout):
                     want = dest_out[j]
                     if want is None:
+                        # unspecified at the destination: a repair holds the source's value
+                        held = {s[j] for s in srcs if s[j] is not None}
+                        if (j, k, q) in fix and len(held) == 1:
+                            outs[j][(x << v) | q] = held.pop()
                         continue
                     if (j, k, q) in fix or any(s[j] == want for s in srcs):
                         outs[j][(x << v) | q] = want
