@@ -122,15 +122,18 @@ def excitation(rt: ReducedTable, asg: Assignment, names: list[str],
                     if rt.out[c][k0] is not None and bin(ft.columns[k0] ^ x).count("1") == 1]
             for q in subcube(code_of[c], code_of[d]):
                 passing.setdefault((k, q), []).append((c, d))
-                if q == code_of[d]:
-                    continue
+                end = q == code_of[d]
                 for j in range(nout):
                     want = dest_out[j]
                     if want is None:
                         # unspecified at the destination: a repair holds the source's value
+                        # all the way, the destination's (unspecified) stable point included
                         held = {s[j] for s in srcs if s[j] is not None}
-                        if (j, k, q) in fix and len(held) == 1:
+                        if (j, k, code_of[c]) in fix and len(held) == 1 and \
+                                outs[j][(x << v) | q] == DC:
                             outs[j][(x << v) | q] = held.pop()
+                        continue
+                    if end:
                         continue
                     if (j, k, q) in fix or any(s[j] == want for s in srcs):
                         outs[j][(x << v) | q] = want
