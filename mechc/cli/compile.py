@@ -129,7 +129,8 @@ def ordering_lines(ordering: dict | None) -> list[str]:
            f"transitions, margin {ordering['margin_s']} s):"] if reqs else []
     for r in reqs:
         verdict = (f"dynamic walk ({r['dynamic_steps']} step(s)): "
-                   + ("met" if r["met"] else f"NOT MET ({r['dynamic_failures']} failure(s))"))
+                   + ("met" if r["met"] else f"NOT MET ({r['dynamic_failures']} failure(s), "
+                                             f"first: {r['first_failure']})"))
         more = len(r["transitions"]) - 1
         out.append(f"  {r['kind']}: {r['requires']} [{r['transitions'][0]}"
                    f"{f' and {more} more' if more else ''}]")

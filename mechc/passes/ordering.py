@@ -74,7 +74,8 @@ class Requirement:
         return {"kind": self.kind, "input": self.input, "memories": self.memories,
                 "requires": self.requires, "transitions": self.where,
                 "timing": self.timing, "dynamic_steps": self.steps,
-                "dynamic_failures": len(self.failures), "met": not self.failures}
+                "dynamic_failures": len(self.failures), "met": not self.failures,
+                "first_failure": failure_text(self.failures[0]) if self.failures else None}
 
 
 def find_requirements(nl: Netlist, spec: SeqSpec,
@@ -335,8 +336,12 @@ def ordering_checks(reqs: list[Requirement], other: list[dict]) -> list[Check]:
 
 
 def failure_text(f: dict) -> str:
-    return f.get("message") or (f"{f.get('kind')}: {f.get('output', '')} expected "
-                                f"{f.get('expected', '?')}")
+    """One line for a failure of the dynamic walk."""
+    step = f" ({f['moving']} to {f['to']})" if "moving" in f else ""
+    if f.get("message"):
+        return f"{f.get('kind', '')}: {f['message']}{step}"
+    return (f"{f.get('kind')}: {f.get('output', '')} expected {f.get('expected', '?')}, "
+            f"at {f.get('position', f.get('max_deviation', '?'))}{step}")
 
 
 def decide_ordering(design: Design, lib: Library,
@@ -439,6 +444,3 @@ def _record(design: Design, reqs: list[Requirement], other: list[dict], cure: di
     dc = design.stats.setdefault("design_checks", {})
     dc.update({"passed": not failed, "count": len(mech.checks),
                "failed": [c.text() for c in failed]})
-    for r in reqs:
-        for f in r.failures[:1]:
-            dc["failed"].append(f"  {r.kind} requirement unmet: {failure_text(f)}")
