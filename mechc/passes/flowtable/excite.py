@@ -126,12 +126,13 @@ def excitation(rt: ReducedTable, asg: Assignment, names: list[str],
                 for j in range(nout):
                     want = dest_out[j]
                     if want is None:
-                        # unspecified at the destination: a repair holds the source's value
-                        # all the way, the destination's (unspecified) stable point included
-                        held = {s[j] for s in srcs if s[j] is not None}
-                        if (j, k, code_of[c]) in fix and len(held) == 1 and \
-                                outs[j][(x << v) | q] == DC:
-                            outs[j][(x << v) | q] = held.pop()
+                        # unspecified at the destination: a repair holds one value all the
+                        # way, the destination's (unspecified) stable point included, so the
+                        # output changes at most once, with the input (the source's value
+                        # where the source columns agree)
+                        held = sorted({s[j] for s in srcs if s[j] is not None})
+                        if (j, k, code_of[c]) in fix and outs[j][(x << v) | q] == DC:
+                            outs[j][(x << v) | q] = held[0] if held else 0
                         continue
                     if end:
                         continue
