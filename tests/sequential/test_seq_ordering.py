@@ -5,6 +5,8 @@ dynamic proof itself, and the timing inequality worked out by hand from the cell
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -172,3 +174,15 @@ def test_accepted_small_random_tables_pass_every_proof(seed):
 @pytest.mark.parametrize("seed", range(1500, 1506))
 def test_accepted_random_tables_pass_every_proof(seed):
     _accepted_pass_everything(_random_spec(seed, (3, 8)))
+
+
+def test_compile_summary_and_json_show_each_requirement(cli, tmp_path):
+    out = tmp_path / "s.json"
+    code, stdout, err = cli("compile", SPEEDCTL, "-o", out)
+    assert code == 0, err
+    assert "ordering requirements (2;" in stdout
+    assert stdout.count("inequality:") == 2 and stdout.count("dynamic walk (1 step(s)): met") == 2
+    obj = json.loads(out.read_text())
+    o = obj["stats"]["sequential"]["ordering"]
+    ess = next(r for r in o["requirements"] if r["kind"] == "essential")
+    assert ess["timing"]["t_input_s"] > 0 and "slack_s" in ess["timing"] and ess["met"]
