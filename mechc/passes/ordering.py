@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import networkx as nx
 
 from mechc.cells.library import Library
+from mechc.errors import MechcError
 from mechc.ir.check import Check
 from mechc.ir.design import Design
 from mechc.ir.netlist import Netlist
@@ -46,6 +47,7 @@ from mechc.ir.seqspec import (
     stable_graph,
 )
 from mechc.passes.amplify import amplifier_cell, amplify_nets
+from mechc.physics.closed_form import KinematicsError
 from mechc.physics.scene import DynSettings
 from mechc.proofs.seq_logic import SeqNetlist, X, _moved, _reachable, ternary_transition
 from mechc.proofs.settings import MEMORY_THROW_S, dyn_settings
@@ -289,7 +291,10 @@ def verify_requirements(design: Design, lib: Library, reqs: list[Requirement],
     seqs = tour_of(spec, set(owner))
     if not seqs:
         return []
-    rep = prove_sequential_dynamic(design, spec, lib, settings=settings, sequences=seqs)
+    try:
+        rep = prove_sequential_dynamic(design, spec, lib, settings=settings, sequences=seqs)
+    except (MechcError, KinematicsError) as e:  # a mechanism the scene cannot run fails too
+        return [{"kind": "error", "message": str(e)}]
     steps = _steps_of(spec, seqs)
     for tr in steps.values():
         for r in owner.get(tr, []):
@@ -381,7 +386,10 @@ def _whole_walk(design: Design, lib: Library) -> list[dict]:
     """The failures of the default sequential dynamic proof (what ``mechc simulate`` runs)."""
     from mechc.proofs.seq_mechanism import prove_sequential_dynamic
 
-    rep = prove_sequential_dynamic(design, design.spec, lib)
+    try:
+        rep = prove_sequential_dynamic(design, design.spec, lib)
+    except (MechcError, KinematicsError) as e:
+        return [{"kind": "error", "message": str(e)}]
     return list(rep["failures"])
 
 
