@@ -7,9 +7,10 @@ pass finds every such requirement on the netlist (the ternary pass of the logic 
 Unger's test on the reduced table), states its timing inequality from the cells' switching
 times, and decides it by driving the pymunk scene through exactly the transitions that need
 it (the sequential dynamic proof's own physics and settings, a handful of steps). Where a
-requirement is not met it builds the cure in — a feedback delay (DELAY cells, see
-``stdlib/delay.py``) on the Q nets of the memories that switch, as many as the inequality asks
-for — and decides again. A requirement still unmet becomes a failed design check, so compile
+requirement is not met it builds the cure in — a feedback delay on the Q nets of the memories
+that switch: a chain of AMPLIFIERs (``stdlib/amplifier.py``, whose bistable toggle is the
+library's measured delay and restores the full stroke), as many as the inequality asks for —
+and decides again. A requirement still unmet becomes a failed design check, so compile
 exits 1 naming it.
 
 The inequality (seconds from the start of the input's move, ``move_time`` long)::
