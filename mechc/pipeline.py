@@ -25,6 +25,7 @@ from mechc.passes.checks import run_design_checks
 from mechc.passes.flowtable import SynthOptions, derive_equations, synthesise_table
 from mechc.passes.map import MapOptions, map_equations, map_sequential
 from mechc.passes.minimise import MinimiseOptions, minimise
+from mechc.passes.ordering import decide_ordering
 from mechc.passes.place import place
 from mechc.proofs.seq_logic import outputs_needing_snap
 
@@ -128,18 +129,29 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
     for m in se.memories:
         equations[se.set_names[m]] = se.text(se.set_names[m])
         equations[se.reset_names[m]] = se.text(se.reset_names[m])
-    mech = None
+
+    def finish(nl: Netlist, layout: Layout | None, amps: dict[str, str]) -> Design:
+        mech = None
+        amps = dict(amps)
+        if mechanism:
+            nl, layout, mech, more = stage("assemble", assemble_powered, nl, lib, opts, layout)
+            amps.update(more)
+        stats = design_stats(se.eq, nl, lib, layout)
+        stats["sequential"] = {"memories": len(se.memories), **se.checked}
+        if amps:
+            stats["amplified"] = amps
+        design = Design(spec, equations, mapped.implemented, nl, layout, stats, seconds,
+                        se.eq, mech, se)
+        if mechanism:
+            stage("check", run_design_checks, design, lib)
+        return design
+
+    design = finish(nl, layout, amps)
     if mechanism:
-        nl, layout, mech, more = stage("assemble", assemble_powered, nl, lib, opts, layout)
-        amps.update(more)
-    stats = design_stats(se.eq, nl, lib, layout)
-    stats["sequential"] = {"memories": len(se.memories), **se.checked}
-    if amps:
-        stats["amplified"] = amps
-    design = Design(spec, equations, mapped.implemented, nl, layout, stats, seconds,
-                    se.eq, mech, se)
-    if mechanism:
-        stage("check", run_design_checks, design, lib)
+        # every ordering requirement decided on the built design, cured where it is not met
+        design = stage("ordering", decide_ordering, design, lib,
+                       lambda nl2, why: finish(nl2, None, {**amps, **why}) if opts.amplify
+                       else None)
     return design
 
 

@@ -153,10 +153,12 @@ def bench_circuits(quick: bool, say: Callable[[str], None]) -> list[Circuit]:
 
 
 def random_flow_table(rng: np.random.Generator, rows: int, inputs: int = 2, outputs: int = 1,
-                      p_entry: float = 0.8) -> FlowTable:
+                      p_entry: float = 0.8, p_dc_output: float = 0.0) -> FlowTable:
     """A random valid primitive flow table (benchmarks and property tests): each row stable
     in one column (every column used while rows last), each single-input change from it
-    specified with probability ``p_entry`` towards a random row stable in the new column."""
+    specified with probability ``p_entry`` towards a random row stable in the new column
+    (else ``-``), each output bit unspecified with probability ``p_dc_output`` (at 0 no extra
+    random numbers are drawn, so seeds give the tables they always gave)."""
     ncol = 1 << inputs
     cols = [i ^ (i >> 1) for i in range(ncol)]  # Gray order, as tables are written
     home = [r % ncol if r < ncol else int(rng.integers(ncol)) for r in range(rows)]
@@ -173,7 +175,10 @@ def random_flow_table(rng: np.random.Generator, rows: int, inputs: int = 2, outp
             if by_col.get(k2) and rng.random() < p_entry:
                 line[k2] = int(rng.choice(by_col[k2]))
         nxt.append(line)
-    out = [[int(v) for v in rng.integers(0, 2, size=outputs)] for _ in range(rows)]
+    out: list[list[int | None]] = [[int(v) for v in rng.integers(0, 2, size=outputs)]
+                                   for _ in range(rows)]
+    if p_dc_output > 0:
+        out = [[None if rng.random() < p_dc_output else v for v in line] for line in out]
     names = [f"s{r + 1}" for r in range(rows)]
     return FlowTable([f"x{i + 1}" for i in range(inputs)], [f"z{j + 1}" for j in range(outputs)],
                      cols, names, nxt, out, 0, None, [0] * rows)

@@ -79,6 +79,8 @@ def run(args: argparse.Namespace) -> int:
         for h in se.essential_hazards:
             print(f"  essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
                   f"{h['to']}: {h['requires']}")
+        for line in ordering_lines(st.get("sequential", {}).get("ordering")):
+            print(f"  {line}")
     for line in cells_used(design, load_library(args.cell_dirs)):
         print(f"  {line}")
     for net, why in st.get("amplified", {}).items():
@@ -115,3 +117,29 @@ def cells_used(design: Design, lib: Library) -> list[str]:
         lines.append(f"user cell {name} ({cls.source}) for {cls.type}"
                      + (f", instead of the standard {', '.join(std)}" if std else ""))
     return lines
+
+
+def ordering_lines(ordering: dict | None) -> list[str]:
+    """The ordering requirements as decided at compile: each with its timing inequality and
+    the verdict of the dynamic walk over its transitions, and the cure built in."""
+    if not ordering:
+        return []
+    reqs = ordering["requirements"]
+    out = [f"ordering requirements ({len(reqs)}; each decided by a dynamic walk of its "
+           f"transitions, margin {ordering['margin_s']} s):"] if reqs else []
+    for r in reqs:
+        verdict = (f"dynamic walk ({r['dynamic_steps']} step(s)): "
+                   + ("met" if r["met"] else f"NOT MET ({r['dynamic_failures']} failure(s), "
+                                             f"first: {r['first_failure']})"))
+        more = len(r["transitions"]) - 1
+        out.append(f"  {r['kind']}: {r['requires']} [{r['transitions'][0]}"
+                   f"{f' and {more} more' if more else ''}]")
+        out.append(f"    inequality: {r['timing']['text']}; {verdict}")
+    cure = ordering.get("cure") or {}
+    if cure:
+        chain = ", ".join(f"{n} x{k}" for n, k in cure["feedback_delay_on"].items())
+        out.append(f"feedback delay {'built in' if cure['kept'] else 'tried, not kept'}: "
+                   f"{cure['cell']} chain ({cure['delay_per_cell_s']} s each) on {chain}; "
+                   f"failing steps {cure['failing_steps_before']} -> "
+                   f"{cure['failing_steps_after']}")
+    return out

@@ -80,9 +80,11 @@ def snap_outputs(nl: Netlist, lib: Library, outputs: Iterable[str]) -> Netlist:
     return _rebuild(nl, lib, cells, outs)
 
 
-def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str]) -> Netlist:
+def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
+                 reason: str = "force") -> Netlist:
     """Every load of each named net moves behind AMPLIFIERs, at most the measured fan-out per
-    amplifier; primary outputs on the net stay on it (their load is small)."""
+    amplifier; primary outputs on the net stay on it (their load is small). ``reason`` is
+    recorded in each new cell's params (force, or a feedback delay)."""
     amp = amplifier_cell(lib)
     limit = fanout_limit(lib)
     names = _names(nl)
@@ -103,7 +105,7 @@ def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str]) -> Netlist:
         for g in range(0, len(ls), limit):
             new = _fresh(f"{net}_amp", names)
             extra.append(CellInst(_fresh("a", names), amp.name, "AMPLIFIER", (net,), (new,),
-                                  {"reason": "force"}))
+                                  {"reason": reason}))
             for cid, k in ls[g:g + limit]:
                 c = cells[cid]
                 ins = list(c.inputs)

@@ -92,7 +92,8 @@ def excitation(rt: ReducedTable, asg: Assignment, names: list[str],
                maps: list[dict[int, int]], fix: set[tuple[int, int, int]] = frozenset()
                ) -> Excitation:
     """``fix``: (output, column, code) whose transient value must be the destination's (a
-    repair for an output that would otherwise change twice)."""
+    repair for an output that would otherwise change twice), or the source's where the
+    destination leaves the output unspecified."""
     ft = rt.ft
     n, v = ft.n, asg.width
     size = 1 << (n + v)
@@ -121,11 +122,19 @@ def excitation(rt: ReducedTable, asg: Assignment, names: list[str],
                     if rt.out[c][k0] is not None and bin(ft.columns[k0] ^ x).count("1") == 1]
             for q in subcube(code_of[c], code_of[d]):
                 passing.setdefault((k, q), []).append((c, d))
-                if q == code_of[d]:
-                    continue
+                end = q == code_of[d]
                 for j in range(nout):
                     want = dest_out[j]
                     if want is None:
+                        # unspecified at the destination: a repair holds one value all the
+                        # way, the destination's (unspecified) stable point included, so the
+                        # output changes at most once, with the input (the source's value
+                        # where the source columns agree)
+                        held = sorted({s[j] for s in srcs if s[j] is not None})
+                        if (j, k, code_of[c]) in fix and outs[j][(x << v) | q] == DC:
+                            outs[j][(x << v) | q] = held[0] if held else 0
+                        continue
+                    if end:
                         continue
                     if (j, k, q) in fix or any(s[j] == want for s in srcs):
                         outs[j][(x << v) | q] = want

@@ -38,8 +38,14 @@ def double_changes(rt: ReducedTable, asg: Assignment, exc: Excitation,
             if d is None or d == c:
                 continue
             a, b = asg.codes[c], asg.codes[d]
+            # the columns the machine may come from, stable in c: the input's own change at
+            # code a is the first change an output may make
+            olds = [ft.columns[k0] for k0 in range(len(ft.columns))
+                    if rt.next[c][k0] == c and bin(ft.columns[k0] ^ x).count("1") == 1]
             for j in range(len(ft.outputs)):
-                if any(_max_changes(f, x, v, a, b) > 1 for f in forms[j]):
+                if any(_max_changes(f, x, v, a, b) + max(
+                        (int(f[(x0 << v) | a] != f[(x << v) | a]) for x0 in olds), default=0)
+                       > 1 for f in forms[j]):
                     bad |= {(j, k, q) for q in subcube(a, b) if q != b}
     return bad
 
