@@ -60,6 +60,9 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
         out["mechanism"] = mechanism_json(mech)
     if getattr(d, "sequential", None) is not None:
         out["sequential"] = d.sequential.to_json()
+    # where each library cell came from (mechc/cells/sources.py): simulate reloads user cells
+    if d.cell_sources:
+        out["cell_sources"] = {k: dict(v) for k, v in sorted(d.cell_sources.items())}
     return out
 
 
@@ -284,8 +287,10 @@ def design_from_json(obj: dict, where: str = "<json>") -> Design:
             mech = mechanism_from_json(obj["mechanism"], obj["cells"])
         except DECODE_ERRORS as e:
             raise UsageError(f"{where}: inconsistent mechanism geometry: {_why(e)}") from None
-    return Design(spec, obj.get("equations", {}), obj.get("implemented", {}), nl, layout,
-                  obj.get("stats", {}), mechanism=mech)
+    design = Design(spec, obj.get("equations", {}), obj.get("implemented", {}), nl, layout,
+                    obj.get("stats", {}), mechanism=mech)
+    design.cell_sources = dict(obj.get("cell_sources") or {})  # mechc/cells/sources.py
+    return design
 
 
 def _spec_from_json(d: dict, where: str):

@@ -15,6 +15,7 @@ never pressing together.
 from __future__ import annotations
 
 from mechc.cells.library import Library
+from mechc.cells.prove_cell import user_cell_checks
 from mechc.ir.check import Check
 from mechc.ir.design import Design
 from mechc.physics.measures import CheckStats
@@ -51,7 +52,7 @@ def cell_checks(design: Design, lib: Library) -> list[Check]:
     for cid in mech.order:
         cls = lib[design.netlist.cells[cid].cell]
         out += cls.checks(cid, mech.cells[cid], mech.ctx)
-    return out
+    return out + user_cell_checks(design, lib)  # each user cell proven alone, once
 
 
 def _memory_checks(design: Design, lib: Library, stats: CheckStats) -> list[Check]:

@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from mechc.cells.library import Library
-from mechc.errors import DesignError
 from mechc.ir import expr as ex
 from mechc.ir.equations import Cover, Equations
 from mechc.ir.logic_types import TYPES
@@ -41,7 +40,7 @@ class Planner:
     def limit(self, type_name: str) -> int:
         lib_max = self.lib.max_fan_in(type_name)
         if lib_max == 0:
-            raise DesignError(f"the cell library has no cell of type {type_name}")
+            raise self.lib.no_cell_error(type_name)
         return min(lib_max, self.fan_in) if self.fan_in else lib_max
 
     def gate(self, type_name: str, ins: list[Key]) -> Key:
