@@ -16,6 +16,7 @@ import importlib.util
 import inspect
 import os
 import pkgutil
+import re
 import sys
 import traceback
 from collections.abc import Iterable
@@ -85,6 +86,7 @@ class Library:
 
 
 _CACHE: dict[tuple, Library] = {}
+TYPE_NAME = re.compile(r"[A-Z][A-Z0-9_]*")  # as the design JSON schema requires
 _WARNED: set[str] = set()  # broken-file messages already printed (once per process)
 
 #: The package of the standard cells (the repository's stdlib/ directory).
@@ -221,6 +223,9 @@ def _collect(mod, path: Path, standard: bool) -> list[type[Cell]]:
 def _declare(obj: type[Cell], path: Path) -> None:
     """Register the logic type a cell declares with ``function`` or ``truth``."""
     line = _line(obj)
+    if not TYPE_NAME.fullmatch(obj.type):
+        raise CellFileError(line, f"cell '{obj.name}': type {obj.type!r}: a logic type is "
+                            "written in capitals, digits and '_' (e.g. MAJ3)")
     if obj.function and obj.truth:
         raise CellFileError(line, f"cell '{obj.name}': give function or truth, not both")
     if obj.min_inputs != obj.max_inputs:
