@@ -24,7 +24,7 @@ from pathlib import Path
 
 from mechc.cells.cell import Cell
 from mechc.errors import DesignError, MechcError, UsageError
-from mechc.ir.logic_types import TYPES, declare_type, table_from_function, table_from_truth
+from mechc.ir.logic_types import BUILTIN, TYPES, declare_type, table_from_function, table_from_truth
 
 
 class Library:
@@ -140,6 +140,7 @@ def load_library(extra_dirs: Iterable[str] = (), files: Iterable[str] = ()) -> L
             seen.add(Path(f).resolve())
     for f in user_files:
         _load_file(f, lambda f=f: _import_file(f), found, broken, standard=False)
+    _drop_undeclared(found, broken)
     for msg in broken.values():
         if msg not in _WARNED:
             _WARNED.add(msg)
@@ -147,6 +148,25 @@ def load_library(extra_dirs: Iterable[str] = (), files: Iterable[str] = ()) -> L
     lib = Library(found, broken)
     _CACHE[key] = lib
     return lib
+
+
+def _drop_undeclared(found: dict[str, type[Cell]], broken: dict[str, str]) -> None:
+    """A cell of a declared type needs the declaring cell in this library (the type registry is
+    per process: a file loaded for another library may have declared it)."""
+    declared = {c.type for c in found.values() if c.function or c.truth}
+    for cell in list(found.values()):
+        t = TYPES[cell.type]
+        if t.table is None or cell.type in declared or cell.source in broken:
+            continue
+        broken[cell.source] = (f"{cell.source}:{_line(cell)}: " + _unknown_type(cell))
+        for other in [c for c in found.values() if c.source == cell.source]:
+            del found[other.name]
+
+
+def _unknown_type(obj: type[Cell]) -> str:
+    return (f"cell '{obj.name}' declares unknown logic type '{obj.type}': declare a new type "
+            "in the cell with function = \"...\" (an expression over its pins) or truth = "
+            f"\"...\" (known types: {', '.join(sorted(BUILTIN))})")
 
 
 def file_sha256(path: str | Path) -> str:
@@ -210,10 +230,7 @@ def _collect(mod, path: Path, standard: bool) -> list[type[Cell]]:
         if obj.function or obj.truth:
             _declare(obj, path)
         elif obj.type not in TYPES:
-            raise CellFileError(_line(obj), f"cell '{obj.name}' declares unknown logic type "
-                                f"'{obj.type}': declare a new type in the cell with "
-                                "function = \"...\" (an expression over its pins) or truth = "
-                                f"\"...\" (known types: {', '.join(TYPES)})")
+            raise CellFileError(_line(obj), _unknown_type(obj))
         if any(obj.name in (c.name,) for c in out):
             raise CellFileError(_line(obj), f"cell name '{obj.name}' is defined twice")
         out.append(obj)
