@@ -132,7 +132,9 @@ def load_library(extra_dirs: Iterable[str] = (), files: Iterable[str] = ()) -> L
             raise UsageError(f"cell directory '{d}' "
                              + ("is a file, not a directory of cell files" if p.exists()
                                 else "does not exist"))
-        user_files += [f for f in sorted(p.glob("*.py")) if not f.name.startswith("_")]
+        # _helpers.py and test_*.py (a cell's tests, as mechc new-cell writes) are not cells
+        user_files += [f for f in sorted(p.glob("*.py"))
+                       if not f.name.startswith(("_", "test_"))]
     seen = {f.resolve() for f in user_files}
     for f in files:  # a recorded source already in a --cells directory is loaded once
         if Path(f).resolve() not in seen:
