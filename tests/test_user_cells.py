@@ -218,3 +218,25 @@ def test_a_changed_or_missing_cell_file_is_detected(cli, tmp_path):
     f.unlink()
     rc, _, err = cli("simulate", design, "--level", "logic")
     assert rc == 2 and f"compiled from {f.resolve()}, which no longer exists" in err
+
+
+def test_documented_maj_cell_is_chosen_by_cost_for_majority(cli, tmp_path):
+    """docs/write-a-cell.md's MAJ example, run as printed: one MAJ cell of 15 parts against 17
+    for three ANDs and an OR, proven without --cells at the kinematic level."""
+    import re
+
+    from tests.test_docs import DOC
+
+    code = re.search(r"```python\n(# my_cells/maj3.py\n.*?)```", DOC.read_text(), re.S)
+    cells = tmp_path / "my_cells"
+    cells.mkdir()
+    (cells / "maj3.py").write_text(code.group(1))
+    design, plain = tmp_path / "m.json", tmp_path / "p.json"
+    rc, out, err = cli("compile", EXAMPLES / "majority.pla", "--cells", cells, "-o", design)
+    assert rc == 0, err
+    d = json.loads(design.read_text())
+    assert [c["type"] for c in d["cells"]] == ["MAJ"] and d["stats"]["parts"] == 15
+    assert cli("compile", EXAMPLES / "majority.pla", "-o", plain)[0] == 0
+    assert json.loads(plain.read_text())["stats"]["parts"] == 17
+    rc, out, err = cli("simulate", design, "--level", "kinematic")
+    assert rc == 0 and "PASSED" in out, err
