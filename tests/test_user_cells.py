@@ -240,3 +240,28 @@ def test_documented_maj_cell_is_chosen_by_cost_for_majority(cli, tmp_path):
     assert json.loads(plain.read_text())["stats"]["parts"] == 17
     rc, out, err = cli("simulate", design, "--level", "kinematic")
     assert rc == 0 and "PASSED" in out, err
+
+
+def test_a_broken_file_in_the_standard_library_does_not_stop_commands(cli, tmp_path,
+                                                                      monkeypatch):
+    """A copy of stdlib/ with one broken file added: compiling an unrelated spec still works and
+    the file is named once; a design that needs a missing cell names it (exit 2)."""
+    import mechc.cells.library as library
+
+    root = EXAMPLES.parent
+    pkg = tmp_path / "std_copy"
+    shutil.copytree(root / "stdlib", pkg)
+    (pkg / "zz_broken.py").write_text("import math\n\nmath.no_such_function()\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setattr(library, "STDLIB", "std_copy")
+    monkeypatch.setattr(library, "_CACHE", {})
+    design = tmp_path / "s.json"
+    rc, out, err = cli("compile", EXAMPLES / "sorter.bool", "-o", design)
+    assert rc == 0 and design.exists()
+    assert err.count("zz_broken.py:3:") == 1 and "AttributeError" in err
+    d = json.loads(design.read_text())
+    d["cells"][0]["cell"] = "no_such_cell"
+    d["cell_sources"] = {"no_such_cell": {"library": "standard"}}
+    design.write_text(json.dumps(d))
+    rc, _, err = cli("simulate", design, "--level", "kinematic")  # moves the cells' geometry
+    assert rc == 2 and "unknown library cell 'no_such_cell'" in err and "zz_broken.py:3" in err

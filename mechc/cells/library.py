@@ -233,7 +233,7 @@ def _collect(mod, path: Path, standard: bool) -> list[type[Cell]]:
             _declare(obj, path)
         elif obj.type not in TYPES:
             raise CellFileError(_line(obj), _unknown_type(obj))
-        if any(obj.name in (c.name,) for c in out):
+        if any(c.name == obj.name for c in out):
             raise CellFileError(_line(obj), f"cell name '{obj.name}' is defined twice")
         out.append(obj)
     return out

@@ -176,7 +176,10 @@ def declare_type(name: str, table: tuple[int, ...], source: str, doc: str = "") 
             return _differ(name, table, want, "the built-in type")
         return TYPES[name]
     old = TYPES.get(name)
-    if old is not None:
+    if old is not None and old.source != source:  # the same file, edited and loaded again: new
+        if len(old.table) != len(table):
+            raise ValueError(f"type {name} has {old.min_inputs} inputs in {old.source}, "
+                             f"{n} here")
         if old.table != tuple(table):
             return _differ(name, table, old.table, f"the type declared in {old.source}")
         return old
