@@ -174,6 +174,20 @@ def check_design(obj: dict, where: str) -> None:
     check_numbers(obj, where)
     validate(obj, where)
     check_references(obj, where)
+    check_cell_types(obj, where)
+
+
+def check_cell_types(obj: dict, where: str) -> None:
+    """A logic type that is not built in was declared by a user cell file: the cell must have
+    one in ``cell_sources`` (mechc/cells/sources.py), else the type means nothing here."""
+    from mechc.ir.logic_types import BUILTIN
+
+    sources = obj.get("cell_sources") or {}
+    for i, c in enumerate(obj["cells"]):
+        if c["type"] not in BUILTIN and sources.get(c["cell"], {}).get("library") != "user":
+            raise UsageError(f"{where}: not a valid mechc design at cells/{i}/type: "
+                             f"{c['type']!r} is not a built-in logic type, and cell "
+                             f"{c['cell']!r} has no user cell file in cell_sources to declare it")
 
 
 def check_numbers(obj, where: str) -> None:
