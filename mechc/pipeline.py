@@ -13,6 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from mechc.cells.library import Library, load_library
+from mechc.cells.sources import cell_sources
 from mechc.ir.design import Design
 from mechc.ir.equations import Equations
 from mechc.ir.layout import Layout
@@ -67,6 +68,7 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
         stats["amplified"] = amps
     design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
                     nl, layout, stats, seconds, eq, mech)
+    design.cell_sources = cell_sources(nl, lib)
     stage("check", run_design_checks, design, lib)
     return design
 
@@ -142,6 +144,7 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
             stats["amplified"] = amps
         design = Design(spec, equations, mapped.implemented, nl, layout, stats, seconds,
                         se.eq, mech, se)
+        design.cell_sources = cell_sources(nl, lib)
         if mechanism:
             stage("check", run_design_checks, design, lib)
         return design
@@ -192,6 +195,7 @@ def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = 
     mech = assemble_mechanism(netlist, layout, lib, opts.mech)
     stats = {"cells": len(netlist.cells), "cells_by_type": netlist.count_by_type()}
     design = Design(spec, {}, {}, netlist, layout, stats, {}, None, mech)
+    design.cell_sources = cell_sources(netlist, lib)
     run_design_checks(design, lib)
     return design
 

@@ -179,9 +179,17 @@ def test_json_has_the_required_keys_and_validates(cli, tmp_path):
     for key in ["cells_by_type", "literals", "minimisation"]:
         assert key in d["stats"]
     jsonschema.validate(d, schema())
-    bad = dict(d, cells=[dict(d["cells"][0], type="FLIPFLOP")])
+    bad = dict(d, cells=[dict(d["cells"][0], type="flip flop")])
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(bad, schema())
+    # a capitalised name may be a type a cell file declares: only with that file recorded
+    from mechc.backends.design_json import check_cell_types
+    from mechc.errors import UsageError
+
+    bad = dict(d, cells=[dict(d["cells"][0], type="FLIPFLOP")])
+    jsonschema.validate(bad, schema())
+    with pytest.raises(UsageError, match="'FLIPFLOP' is not a built-in logic type"):
+        check_cell_types(bad, "s.json")
 
 
 def test_two_runs_are_byte_identical(cli, tmp_path):

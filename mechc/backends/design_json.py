@@ -60,6 +60,9 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
         out["mechanism"] = mechanism_json(mech)
     if getattr(d, "sequential", None) is not None:
         out["sequential"] = d.sequential.to_json()
+    # where each library cell came from (mechc/cells/sources.py): simulate reloads user cells
+    if d.cell_sources:
+        out["cell_sources"] = {k: dict(v) for k, v in sorted(d.cell_sources.items())}
     return out
 
 
@@ -171,6 +174,20 @@ def check_design(obj: dict, where: str) -> None:
     check_numbers(obj, where)
     validate(obj, where)
     check_references(obj, where)
+    check_cell_types(obj, where)
+
+
+def check_cell_types(obj: dict, where: str) -> None:
+    """A logic type that is not built in was declared by a user cell file: the cell must have
+    one in ``cell_sources`` (mechc/cells/sources.py), else the type means nothing here."""
+    from mechc.ir.logic_types import BUILTIN
+
+    sources = obj.get("cell_sources") or {}
+    for i, c in enumerate(obj["cells"]):
+        if c["type"] not in BUILTIN and sources.get(c["cell"], {}).get("library") != "user":
+            raise UsageError(f"{where}: not a valid mechc design at cells/{i}/type: "
+                             f"{c['type']!r} is not a built-in logic type, and cell "
+                             f"{c['cell']!r} has no user cell file in cell_sources to declare it")
 
 
 def check_numbers(obj, where: str) -> None:
@@ -284,8 +301,10 @@ def design_from_json(obj: dict, where: str = "<json>") -> Design:
             mech = mechanism_from_json(obj["mechanism"], obj["cells"])
         except DECODE_ERRORS as e:
             raise UsageError(f"{where}: inconsistent mechanism geometry: {_why(e)}") from None
-    return Design(spec, obj.get("equations", {}), obj.get("implemented", {}), nl, layout,
-                  obj.get("stats", {}), mechanism=mech)
+    design = Design(spec, obj.get("equations", {}), obj.get("implemented", {}), nl, layout,
+                    obj.get("stats", {}), mechanism=mech)
+    design.cell_sources = dict(obj.get("cell_sources") or {})  # mechc/cells/sources.py
+    return design
 
 
 def _spec_from_json(d: dict, where: str):

@@ -35,6 +35,8 @@ from mechc.ir.mechanism import (
 
 
 def rect(x0: float, y0: float, x1: float, y1: float) -> list[Point]:
+    """The axis-aligned rectangle with corners (x0, y0) and (x1, y1), in either order, as the
+    counter-clockwise polygon every body outline is made of."""
     xa, xb = sorted((x0, x1))
     ya, yb = sorted((y0, y1))
     return [(xa, ya), (xb, ya), (xb, yb), (xa, yb)]
@@ -42,7 +44,11 @@ def rect(x0: float, y0: float, x1: float, y1: float) -> list[Point]:
 
 @dataclass
 class Sig:
-    """A signal inside a cell: a slider whose displacement is the signal, and where it reaches."""
+    """A signal inside a cell: a slider whose displacement is the signal, and where it reaches.
+
+    ``body`` is the slider's id, ``x`` its right-most point (its tip) at the design pose and
+    ``y`` its row. Blocks take signals and return new ones; set ``y`` on a returned bar to choose
+    the row its output lug (and the output terminal) sits on."""
 
     body: str
     x: float  # right-most x the body reaches (its tip) at the design pose
@@ -50,7 +56,12 @@ class Sig:
 
 
 class Builder:
-    """Accumulates the bodies, joints and springs of one cell (ids prefixed by the cell id)."""
+    """Accumulates the bodies, joints and springs of one cell (ids prefixed by the cell id).
+
+    Make one per instance in ``Cell.synthesise(cid, ctx, ...)`` as ``Builder(cid, ctx)``;
+    ``ctx`` holds the design rules (``stroke``, bar width ``bar``, row ``pitch``, lever ``arm``,
+    ``friction``, spring ``margin`` ...). Lay everything out at the design pose (every signal at
+    half stroke), then return ``finish(...)``."""
 
     def __init__(self, cid: str, ctx: SynthContext):
         self.cid, self.ctx, self.part = cid, ctx, Part()
@@ -58,6 +69,8 @@ class Builder:
         self.bars: dict[str, tuple[str, int, Point]] = {}  # bar -> (kind, inputs, spring point)
 
     def name(self, local: str) -> str:
+        """The id of this cell's body called ``local``: ``"{cid}.{local}"`` (so two
+        instances of a cell never share a body id)."""
         return f"{self.cid}.{local}"
 
     def _id(self, kind: str) -> str:
@@ -67,6 +80,10 @@ class Builder:
     # ---- bodies -----------------------------------------------------------------------------
     def slider(self, local: str, x0: float, x1: float, y: float, role: str,
                layer: int = 0) -> Sig:
+        """A horizontal slider: a bar ``ctx.bar`` wide from ``x0`` to ``x1`` on row ``y``,
+        guided along x. ``role`` labels it in drawings and reports; ``layer`` is the plane it
+        moves in (bodies on different layers may cross). Returns it as a signal whose tip is
+        ``x1``; it is no terminal until :meth:`terminal` (or use :meth:`input_slider`)."""
         h = self.ctx.bar
         poly = rect(x0, y - h / 2, x1, y + h / 2)
         self.part.bodies.append(Body(self.name(local), "slider", [poly], self.ctx.mass([poly]),
@@ -74,12 +91,14 @@ class Builder:
         return Sig(self.name(local), x1, y)
 
     def extend(self, body: str, poly: list[Point]) -> None:
+        """Add polygon ``poly`` (a lug, a hook) to the outline of ``body``; its mass follows."""
         b = self.part.body(body)
         b.outline.append(poly)
         b.mass = self.ctx.mass(b.outline)
 
     def reach(self, sig: Sig, x: float) -> Sig:
-        """Lengthen a slider to the right so its tip is at ``x`` (a lug on its row)."""
+        """Lengthen a slider to the right so its tip is at ``x`` (a lug on its row); returns
+        the signal with its new tip (the same one if it already reaches ``x``)."""
         if x > sig.x + 1e-9:
             h = self.ctx.bar
             self.extend(sig.body, rect(sig.x, sig.y - h / 2, x, sig.y + h / 2))
@@ -87,6 +106,9 @@ class Builder:
         return sig
 
     def bar(self, local: str, x: float, y_lo: float, y_hi: float, role: str) -> str:
+        """A vertical bar at ``x`` spanning rows ``y_lo`` to ``y_hi``, guided along x on layer
+        1 (over the input sliders); returns its id. :meth:`or_bar` and :meth:`and_bar` make
+        theirs with it and add its contacts, stops and spring."""
         w = self.ctx.bar
         poly = rect(x - w / 2, y_lo - w / 2, x + w / 2, y_hi + w / 2)
         self.part.bodies.append(Body(self.name(local), "slider", [poly], self.ctx.mass([poly]),
@@ -96,28 +118,37 @@ class Builder:
     # ---- joints -----------------------------------------------------------------------------
     def contact(self, a: str, b: str, pa: Point, pb: Point, driven: str,
                 normal: Point = (1.0, 0.0)) -> None:
+        """A one-sided contact: point ``pa`` of body ``a`` pushes point ``pb`` of body ``b``
+        along ``normal`` (they touch at the design pose when ``pa == pb``); it can push, never
+        pull. ``driven`` is the body the contact moves (``b`` when ``a`` pushes it)."""
         self.part.joints.append(Joint(self._id("contact"), "contact", a, b, pa=pa, pb=pb,
                                       normal=normal, driven=driven))
 
     def stop_below(self, body: str, at: Point, travel: float) -> None:
-        """The body may move left by at most ``travel`` from the design pose."""
+        """A stop on the ground at ``at`` (a point of ``body``): the body may move left by at
+        most ``travel`` from the design pose (its off position for a bar: ``S / 2``)."""
         ground = (at[0] - travel, at[1])
         self.part.joints.append(Joint(self._id("stop"), "contact", GROUND, body, pa=ground,
                                       pb=at, normal=(1.0, 0.0), driven=body))
 
     def stop_above(self, body: str, at: Point, travel: float) -> None:
-        """The body may move right by at most ``travel`` from the design pose."""
+        """A stop on the ground at ``at`` (a point of ``body``): the body may move right by at
+        most ``travel`` from the design pose (its on position for a bar: ``S / 2``)."""
         ground = (at[0] + travel, at[1])
         self.part.joints.append(Joint(self._id("stop"), "contact", body, GROUND, pa=at,
                                       pb=ground, normal=(1.0, 0.0), driven=body))
 
     def groove(self, slot_body: str, pin_body: str, p0: Point, p1: Point, q: Point) -> None:
+        """A pin at ``q`` on ``pin_body`` sliding in a straight slot from ``p0`` to ``p1`` on
+        ``slot_body`` (all at the design pose)."""
         self.part.joints.append(Joint(self._id("groove"), "groove", slot_body, pin_body,
                                       p0=p0, p1=p1, q=q))
 
     def spring(self, body: str, at: Point, direction: int, preload: float, mass: float) -> None:
         """A tension spring to a ground anchor: ``direction`` -1 pulls the body towards off
-        (lightest at off), +1 towards on (lightest at on). Preload is the force there."""
+        (lightest at off), +1 towards on (lightest at on). Preload is the force there (N);
+        ``mass`` (the moving mass, :meth:`moving_mass`) sets its damping. The stiffness comes
+        from ``ctx.spring_range`` (the force grows by that fraction over a stroke)."""
         S, c = self.ctx.stroke, self.ctx
         k = c.spring_range * preload / S
         rest = S  # the spring's own length at rest
@@ -133,6 +164,8 @@ class Builder:
                                         damping, preload, f_max, design_coil(k, f_max)))
 
     def terminal(self, pin: str, body: str, point: Point) -> None:
+        """Make ``point`` of ``body`` the terminal ``pin``: at the design pose it is at half
+        stroke, so off is ``S / 2`` to its left and on ``S / 2`` to its right."""
         S = self.ctx.stroke
         self.part.terminals[pin] = Terminal(pin, body, "translating",
                                             (point[0] - S / 2, point[1]),
@@ -140,17 +173,24 @@ class Builder:
 
     # ---- blocks -----------------------------------------------------------------------------
     def input_slider(self, pin: str, x0: float, y: float, length: float) -> Sig:
+        """Input ``pin``: a slider from ``x0`` to ``x0 + length`` on row ``y`` whose left end
+        is the input terminal (put inputs at ``x0 = 0``, rows going down from ``y = 0``)."""
         sig = self.slider(f"in_{pin}", x0, x0 + length, y, f"input {pin}")
         self.terminal(pin, sig.body, (x0, y))
         return sig
 
     def moving_mass(self, bodies: list[str]) -> float:
+        """The summed mass of ``bodies`` (for a spring's damping)."""
         return sum(self.part.body(b).mass for b in bodies)
 
     def or_bar(self, local: str, sigs: list[Sig], x: float, demand: Demand,
                y_extra: list[float] = ()) -> tuple[Sig, list[Demand]]:
-        """OR: bar at ``x`` pushed by every signal; returns the bar as a signal and what each
-        input must push (right) / pull (left)."""
+        """OR: a bar at ``x`` pushed on (right) by every signal in ``sigs`` through one-sided
+        contacts, stopped at off and after over-travel, with a preloaded spring pulling it
+        back to off. Its spring is sized by :meth:`size` for ``demand``, what the bar's output
+        must move each way. ``y_extra``: more rows the bar must span (where it drives
+        something). Returns the bar as a signal (tip on its right face; set ``.y`` to choose the
+        output row) and what each input must then deliver, in the order of ``sigs``."""
         c, S, w = self.ctx, self.ctx.stroke, self.ctx.bar
         ys = [s.y for s in sigs] + list(y_extra)
         y_spring = self.spring_row(ys)
@@ -166,7 +206,9 @@ class Builder:
 
     def and_bar(self, local: str, sigs: list[Sig], x: float, demand: Demand,
                 y_extra: list[float] = ()) -> tuple[Sig, list[Demand]]:
-        """AND: bar at ``x`` sprung towards on, held back by a hook on every signal."""
+        """AND: a bar at ``x`` sprung towards on, held back by a hook on every signal in
+        ``sigs`` (it moves on only when all are on), stopped at on and after over-travel. The
+        arguments and the result are those of :meth:`or_bar`."""
         c, S, w = self.ctx, self.ctx.stroke, self.ctx.bar
         ys = [s.y for s in sigs] + list(y_extra)
         y_spring = self.spring_row(ys)
@@ -184,13 +226,27 @@ class Builder:
 
     def spring_row(self, ys: list[float]) -> float:
         """A row above the inputs for the next bar's spring: springs lie on the base plate,
-        each on its own row, so they never cross one another."""
+        each on its own row, so they never cross one another. Returns that row's y."""
         self.spring_rows = getattr(self, "spring_rows", 0) + 1
         return max(ys) + self.ctx.bar * (0.5 + 1.2 * self.spring_rows)
 
     def size(self, bar: str, demand: Demand) -> list[Demand]:
         """(Re)size a bar's spring for the force its output must deliver; returns what each of
-        its inputs must then deliver. OR springs pull towards off, AND springs towards on."""
+        its inputs must then deliver. OR springs pull towards off, AND springs towards on.
+
+        The forces are budgeted from the output back, but a cell is built from its inputs
+        forward: a bar that drives another block inside the cell is made first with
+        ``Demand()`` (nothing known yet). Once the block it drives is made and has returned
+        its input loads, call ``size(bar.body, load)``: the bar's old spring is replaced (never
+        added to) and the loads returned are the ones to pass on to :meth:`finish`. Example,
+        two AND bars feeding an OR bar (the standard XOR)::
+
+            bar1, _ = b.and_bar("bar1", [a, nb], x1, Demand())
+            bar2, _ = b.and_bar("bar2", [bb, na], x2, Demand())
+            bar3, (l1, l2) = b.or_bar("bar3", [bar1, bar2], x3, demand)
+            la, lnb = b.size(bar1.body, l1)  # now bar1 knows what it must push
+            lb, lna = b.size(bar2.body, l2)
+        """
         c = self.ctx
         kind, n, at = self.bars[bar]
         self.part.springs[:] = [s for s in self.part.springs if s.b != bar]
@@ -208,6 +264,8 @@ class Builder:
         return [Demand(0.0, peak + demand.left + c.friction) for _ in range(n)]
 
     def rod(self, a: str, b: str, pa: Point, pb: Point) -> None:
+        """A rigid rod pinned to point ``pa`` of body ``a`` and ``pb`` of body ``b``; its
+        length is their distance at the design pose."""
         length = math.hypot(pb[0] - pa[0], pb[1] - pa[1])
         self.part.joints.append(Joint(self._id("rod"), "rod", a, b, pa=pa, pb=pb,
                                       length=length))
@@ -216,7 +274,12 @@ class Builder:
                   out_length: float, layer: int = 2) -> tuple[Sig, Demand]:
         """NOT: a lever pivoted at its centre, linked by a short rod at its top to ``sig``
         (at row ``y_top``) and by another at its bottom to a new slider two arms lower, which
-        therefore moves opposite (Fig. 16c: a ternary link with binary links to the sliders)."""
+        therefore moves opposite (Fig. 16c: a ternary link with binary links to the sliders).
+
+        ``x`` is the lever's axis, ``out_length`` the new slider's length and ``layer`` the
+        lever's plane (use another for a second lever that crosses the first). Returns the new
+        slider as a signal (its row is ``y_top - 2 * ctx.arm``) and what ``sig`` must deliver:
+        ``demand`` mirrored (right and left swap) plus friction."""
         c, S, w, r = self.ctx, self.ctx.stroke, self.ctx.bar, self.ctx.arm
         link = 0.8 * S
         pivot = (x, y_top - r)
@@ -242,5 +305,8 @@ class Builder:
         return sig
 
     def finish(self, demands: dict[str, Demand]) -> Part:
+        """The cell's part, with what each input pin must deliver (``{pin: Demand}``)
+        recorded in ``data["input_loads"]`` for the compiler's force budget; return it from
+        ``synthesise``."""
         self.part.data["input_loads"] = {k: v.to_json() for k, v in demands.items()}
         return self.part

@@ -37,7 +37,13 @@ class Cell:
     Class attributes a subclass sets:
 
     - ``name``: unique library name (lower case), the ``cell`` field of netlist cells;
-    - ``type``: the logic type it realises (``mechc.ir.logic_types.TYPES``);
+    - ``type``: the logic type it realises: a built-in one (``mechc.ir.logic_types.TYPES``) or
+      a new name, declared by ``function`` or ``truth`` (below);
+    - ``function``: the type's Boolean function as an expression in the .bool syntax over the
+      input pin names, e.g. ``"A&B | A&C | B&C"`` (only for a new type, or to restate a
+      built-in one, which is then checked);
+    - ``truth``: the same as a truth table instead, ``"00010111"``: the output for inputs
+      000, 001, ..., 111, first pin the most significant bit;
     - ``min_inputs`` / ``max_inputs``: how many input pins it can have (fan-in);
     - ``pin_kind``: ``"translating"`` or ``"rotating"`` terminals;
     - ``outputs``: output pin names;
@@ -52,7 +58,10 @@ class Cell:
     outputs: ClassVar[tuple[str, ...]] = ("Z",)
     pin_kind: ClassVar[str] = "translating"
     description: ClassVar[str] = ""
+    function: ClassVar[str] = ""  # a new logic type's expression over the input pins
+    truth: ClassVar[str | tuple[int, ...]] = ""  # ... or its truth table (first pin = MSB)
     source: ClassVar[str] = ""  # set by the library loader: file the cell came from
+    source_sha256: ClassVar[str] = ""  # set by the loader: hash of that file's bytes
     standard: ClassVar[bool] = False  # set by the loader: True for the cells of stdlib/
     auto_select: ClassVar[bool] = True  # offered to the mapper by cost (else only on request)
     stateful: ClassVar[bool] = False  # kinematics needs the previous state (MEMORY)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 from mechc.backends.design_json import write_atomic
 from mechc.backends.svg import parse_state, render
-from mechc.cells.library import load_library
+from mechc.cells.sources import library_for_design
 from mechc.cli.common import check_output, compile_options, load_design_or_spec
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 
@@ -45,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"{args.design}: this design has no mechanism geometry; recompile the "
                          "spec with this mechc")
     state = parse_state(args.state, list(design.netlist.inputs))
-    dr = render(design, state, args.scale, not args.no_labels, load_library(args.cell_dirs))
+    lib = library_for_design(design.cell_sources, args.cell_dirs, args.design)
+    dr = render(design, state, args.scale, not args.no_labels, lib)
     write_atomic(out, dr.svg)
     ins = " ".join(f"{k}={v}" for k, v in state.items())
     res = " ".join(f"{k}={int(v > 0.5) if v == v else '?'}" for k, v in dr.outputs.items())

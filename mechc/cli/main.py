@@ -9,7 +9,7 @@ import sys
 import traceback
 
 from mechc import __version__
-from mechc.cli import bench, cells, draw, simulate, synth
+from mechc.cli import bench, cells, draw, new_cell, simulate, synth
 from mechc.cli import compile as compile_cmd
 from mechc.errors import (
     EXIT_INTERNAL,
@@ -66,6 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
     compile_cmd.register(sub)
     simulate.register(sub)
     cells.register(sub)
+    new_cell.register(sub)
     draw.register(sub)
     synth.register(sub)
     bench.register(sub)

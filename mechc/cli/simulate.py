@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from mechc.backends.design_json import dumps, write_atomic
-from mechc.cells.library import Library, load_library
+from mechc.cells.library import Library
+from mechc.cells.sources import library_for_design
 from mechc.cli.common import check_output, compile_options, load_design_or_spec, load_spec
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 from mechc.ir.design import Design
@@ -108,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
     _check_options(args)
     design = load_design_or_spec(args.design, args)
     spec = load_spec(args.spec) if args.spec else design.spec
-    lib = load_library(args.cell_dirs)
+    lib = library_for_design(design.cell_sources, args.cell_dirs, args.design)
     try:
         trace = _recorder(args, design)
         report = _prove(args, design, spec, lib, trace)

@@ -26,3 +26,4 @@ class Design:
     eq: Equations | None = None  # the minimiser's full result (not kept in JSON)
     mechanism: Mechanism | None = None
     sequential: object | None = None  # SeqEquations of a sequential spec (mechc.passes.flowtable)
+    cell_sources: dict = field(default_factory=dict)  # cell -> source (mechc.cells.sources)

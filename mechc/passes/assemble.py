@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from mechc.cells.builder import Builder, rect
 from mechc.cells.library import Library
 from mechc.cells.materials import DEFAULT_MATERIAL, material
-from mechc.errors import DesignError
+from mechc.errors import DesignError, UsageError
 from mechc.geometry.transform import bounds, translate
 from mechc.ir.check import Check
 from mechc.ir.layout import Layout
@@ -194,8 +194,8 @@ def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):
         try:
             part = cls.synthesise(cid, ctx, len(c.inputs), c.params, d)
         except NotImplementedError:
-            raise DesignError(f"cell '{c.cell}' ({cls.source}) has no mechanism: implement "
-                              "synthesise() (see docs/write-a-cell.md)") from None
+            raise UsageError(f"cell '{c.cell}' ({cls.source}) has no mechanism: implement "
+                             "synthesise() (see docs/write-a-cell.md)") from None
         part.data["output_demand"] = d.to_json()
         local[cid] = part
         for net, pin in zip(c.inputs, cls.input_names(len(c.inputs))):

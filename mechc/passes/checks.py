@@ -21,6 +21,7 @@ import numpy as np
 
 from mechc.cells.cell import Cell
 from mechc.cells.library import Library
+from mechc.cells.prove_cell import user_cell_checks
 from mechc.ir.check import Check
 from mechc.ir.design import Design
 from mechc.parts.poses import PoseTee
@@ -68,7 +69,7 @@ def cell_checks(design: Design, lib: Library) -> list[Check]:
     for cid in mech.order:
         cls = lib[design.netlist.cells[cid].cell]
         out += cls.checks(cid, mech.cells[cid], mech.ctx)
-    return out
+    return out + user_cell_checks(design, lib)  # each user cell proven alone, once
 
 
 #: Up to this many MEMORY cells, rest states start from every combination of their states.

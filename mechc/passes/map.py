@@ -7,7 +7,6 @@ SET/RESET equations are mapped the same way and closed through MEMORY cells."""
 from __future__ import annotations
 
 from mechc.cells.library import Library
-from mechc.errors import DesignError
 from mechc.ir.equations import Equations
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.passes.map_sop import MapOptions, Mapped, map_sop
@@ -35,7 +34,7 @@ def map_sequential(eq: Equations, inputs: list[str], memories: list[tuple[str, s
     src = comb.netlist
     mem_cls = library.for_type("MEMORY", 2)
     if mem_cls is None:
-        raise DesignError("the cell library has no MEMORY cell")
+        raise library.no_cell_error("MEMORY")
     nl = Netlist(inputs)
     for c in src.topo_cells():
         cls = library[c.cell]

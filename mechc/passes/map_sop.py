@@ -13,11 +13,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from mechc.cells.library import Library
-from mechc.errors import DesignError
 from mechc.ir import expr as ex
 from mechc.ir.equations import Cover, Equations
 from mechc.ir.logic_types import TYPES
 from mechc.ir.netlist import CellInst, Netlist
+from mechc.passes.map_declared import declared_candidates, declared_expr
 
 Key = tuple  # ("in", name) | ("CONST", value) | (TYPE, (child keys...))
 
@@ -41,7 +41,7 @@ class Planner:
     def limit(self, type_name: str) -> int:
         lib_max = self.lib.max_fan_in(type_name)
         if lib_max == 0:
-            raise DesignError(f"the cell library has no cell of type {type_name}")
+            raise self.lib.no_cell_error(type_name)
         return min(lib_max, self.fan_in) if self.fan_in else lib_max
 
     def gate(self, type_name: str, ins: list[Key]) -> Key:
@@ -163,6 +163,10 @@ def map_sop(eq: Equations, library: Library, opts: MapOptions | None = None) -> 
             xf = eq.xor_forms.get(name)
             if xf is not None:
                 cands.extend(_xor_candidates(pl, xf, eq.inputs))
+        # one cell of a type a cell file declares, where the output is exactly that function
+        declared = [k for k in declared_candidates(cover, eq.inputs, declared_types(library))
+                    if pl.costed(k[0], len(k[1])) is not None]
+        cands.extend(declared)
         # the sum of products is the reference; another form must be strictly cheaper (it may
         # resolve don't-cares differently from the minimised equation)
         best = cands[0]
@@ -171,6 +175,10 @@ def map_sop(eq: Equations, library: Library, opts: MapOptions | None = None) -> 
             c = pl.cost(k, set(built))
             if c < best_cost:
                 best, best_cost = k, c
+        for k in declared:  # --use-cell: a declared-type cell asked for by name wins
+            if any(library[p].type == k[0] for p in opts.prefer):
+                best = k
+                break
         pl.cost(best, built)
         roots[name] = best
     return Mapped(_materialise(roots, eq, library, tuple(opts.prefer)),
@@ -216,6 +224,8 @@ def key_expr(key: Key) -> ex.Expr:
         e = ex.And((a[0], ex.Not(a[1])))
     elif t == "OR_NOT":
         e = ex.Or((a[0], ex.Not(a[1])))
+    elif TYPES.get(t) is not None and TYPES[t].table is not None:
+        return declared_expr(t, a)
     else:
         raise ValueError(t)
     return ex.Not(e) if t in ("NAND", "NOR", "XNOR") else e
@@ -262,3 +272,9 @@ def _materialise(roots: dict[str, Key], eq: Equations, library: Library,
         nl.set_output(name, build(key))
     nl.check()
     return nl
+
+
+def declared_types(library: Library) -> list[str]:
+    """The logic types the library's cells declare (not built in), sorted."""
+    return sorted({c.type for c in library.cells.values()
+                   if TYPES.get(c.type) is not None and TYPES[c.type].table is not None})
