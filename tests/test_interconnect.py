@@ -316,3 +316,33 @@ def test_a_design_of_the_previous_format_still_proves(designs):
     for k in a:
         assert np.allclose(a[k], b[k], atol=1e-9)
     assert prove(legacy, spec, LIB, "kinematic").passed
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_router_conflict_test_against_brute_force_shifts(seed):
+    """``route.conflict`` (rectangles stretched by the sweeps) against shapely distances of the
+    two rectangles at 401 relative shifts along x: it says "conflict" exactly when some shift
+    brings them within the clearance (up to the grid's step)."""
+    from mechc.passes.route import Piece, conflict
+
+    rng = np.random.default_rng(seed)
+    for _ in range(150):
+        rects = []
+        for _ in range(2):
+            x0, y0 = rng.uniform(0, 60, 2)
+            rects.append((x0, y0, x0 + rng.uniform(1, 30), y0 + rng.uniform(1, 10)))
+        sa, sb = rng.uniform(0, 12, 2)
+        p = Piece("p", "n1", (rects[0],), (sa, 0.0), True)
+        q = Piece("q", "n2", (rects[1],), (sb, 0.0), True)
+        a = shapely.box(*rects[0])
+        shifts = np.linspace(-(sa + sb), sa + sb, 401)
+        d = min(a.distance(shapely.box(rects[1][0] + s, rects[1][1], rects[1][2] + s,
+                                       rects[1][3])) for s in shifts)
+        step = shifts[1] - shifts[0]
+        if conflict(p, q, CLEARANCE):
+            assert d < CLEARANCE + step
+        else:
+            assert d >= CLEARANCE - 1e-9
+        # one net: no relative motion, the outlines as they stand
+        same = Piece("q", "n1", (rects[1],), (sb, 0.0), True)
+        assert conflict(p, same, CLEARANCE) == (a.distance(shapely.box(*rects[1])) < CLEARANCE)
