@@ -346,3 +346,23 @@ def test_router_conflict_test_against_brute_force_shifts(seed):
         # one net: no relative motion, the outlines as they stand
         same = Piece("q", "n1", (rects[1],), (sb, 0.0), True)
         assert conflict(p, same, CLEARANCE) == (a.distance(shapely.box(*rects[1])) < CLEARANCE)
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_dsatur_colours_properly_and_two_colours_a_bipartite_graph(seed):
+    """Every edge gets two colours; DSATUR is exact on bipartite graphs (two colours), and
+    never uses more than the largest degree + 1."""
+    import networkx as nx
+
+    from mechc.passes.route import dsatur
+
+    rng = np.random.default_rng(seed)
+    for g in (nx.gnp_random_graph(60, 0.1, seed=seed),
+              nx.bipartite.random_graph(25, 30, 0.15, seed=seed)):
+        adj = {str(v): {str(u) for u in g[v]} for v in g}
+        order = [str(v) for v in rng.permutation(list(g))]
+        col = dsatur(adj, order)
+        assert set(col) == set(adj)
+        assert all(col[a] != col[b] for a in adj for b in adj[a])
+        assert max(col.values()) + 1 <= max(dict(g.degree).values()) + 1
+    assert max(col.values()) + 1 <= 2  # the bipartite one
