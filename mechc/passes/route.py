@@ -91,8 +91,8 @@ def dsatur(adj: dict[str, set[str]], order: list[str]) -> dict[str, int]:
     """Greedy colouring in DSATUR order (Brélaz): next the uncoloured vertex whose neighbours
     already use the most colours, then the one of most neighbours, then the first in
     ``order``; each takes the smallest colour none of its neighbours has. A heap with stale
-    entries skipped keeps it O((V + E) log V) (networkx's DSATUR rescans every vertex per step,
-    minutes on a thousand rods)."""
+    entries skipped keeps it O((V + E) log V) (networkx's DSATUR rescans every vertex per step:
+    16 s on a design of 856 rods)."""
     rank = {k: i for i, k in enumerate(order)}
     seen: dict[str, set[int]] = {k: set() for k in order}
     heap = [(0, -len(adj[k]), rank[k], k) for k in order]
