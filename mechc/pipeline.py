@@ -28,6 +28,7 @@ from mechc.passes.map import MapOptions, map_equations, map_sequential
 from mechc.passes.minimise import MinimiseOptions, minimise
 from mechc.passes.ordering import decide_ordering
 from mechc.passes.place import place
+from mechc.passes.route import interconnect_stats
 from mechc.proofs.seq_logic import outputs_needing_snap
 
 
@@ -64,6 +65,7 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
     nl, layout, mech, amps = stage("assemble", assemble_powered, mapped.netlist, lib, opts,
                                    layout)
     stats = design_stats(eq, nl, lib, layout)
+    stats.update(interconnect_stats(mech))
     if amps:
         stats["amplified"] = amps
     design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
@@ -140,6 +142,8 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
             amps.update(more)
         stats = design_stats(se.eq, nl, lib, layout)
         stats["sequential"] = {"memories": len(se.memories), **se.checked}
+        if mech is not None:
+            stats.update(interconnect_stats(mech))
         if amps:
             stats["amplified"] = amps
         design = Design(spec, equations, mapped.implemented, nl, layout, stats, seconds,
@@ -193,7 +197,8 @@ def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = 
     netlist.check()
     layout = place(netlist)
     mech = assemble_mechanism(netlist, layout, lib, opts.mech)
-    stats = {"cells": len(netlist.cells), "cells_by_type": netlist.count_by_type()}
+    stats = {"cells": len(netlist.cells), "cells_by_type": netlist.count_by_type(),
+             **interconnect_stats(mech)}
     design = Design(spec, {}, {}, netlist, layout, stats, {}, None, mech)
     design.cell_sources = cell_sources(netlist, lib)
     run_design_checks(design, lib)

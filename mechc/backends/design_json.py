@@ -259,6 +259,15 @@ def check_references(obj: dict, where: str) -> None:
                           "cannot be negative")
         for k, t in part["terminals"].items():
             known((*path, "terminals", k, "body"), t["body"])
+    for net, part in mech["nets"].items():  # a net's rod: one pin from its driver, one to its load
+        for i, b in enumerate(part["bodies"]):
+            ends = [sum(1 for j in part["joints"] if j["kind"] == "pin" and j[k] == b["id"])
+                    for k in ("b", "a")]
+            if b["kind"] != "pushrod" or ends != [1, 1]:
+                raise bad(("mechanism", "nets", net, "bodies", i),
+                          "a net's body must be a pushrod with one pin from its driver (b = "
+                          f"the rod) and one to its load (a = the rod); {b['id']!r} is a "
+                          f"{b['kind']} with {ends[0]} and {ends[1]}")
     geometry = {c["id"]: c["geometry"] for c in obj["cells"] if "geometry" in c}
     order = mech["order"]
     if sorted(order) != sorted(geometry):

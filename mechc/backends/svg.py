@@ -3,12 +3,13 @@ builds it.
 
 Every body is drawn at the pose the kinematic solver gives for that state (not at the design
 pose), so two drawings of the same design in two states show what moves and by how much. Ground
-(pivots, spring anchors, stops) is hatched; grooves are slots with their pin; rods are thin lines
-between pin circles. Each part kind says which of these shapes it shows (``mechc.parts``); this
-module says how a shape looks and in which order shapes are painted. Coordinates are world
-millimetres times ``scale``, y flipped (SVG y grows downwards). Symbols too small to see at the
-chosen scale (pins, pivots, hatches) get a minimum size in pixels; outlines never do, so the
-drawing stays true to scale.
+(pivots, spring anchors, stops) is hatched; grooves are slots with their pin; rods inside cells
+are thin lines between pin circles; the nets' rods are bars of plate with a pin at each end,
+drawn over the cells in the connectors' colours. Each part kind says which of these shapes it
+shows (``mechc.parts``); this module says how a shape looks and in which order shapes are
+painted. Coordinates are world millimetres times ``scale``, y flipped (SVG y grows downwards).
+Symbols too small to see at the chosen scale (pins, pivots, hatches) get a minimum size in
+pixels; outlines never do, so the drawing stays true to scale.
 """
 
 from __future__ import annotations
@@ -39,7 +40,7 @@ _CONNECTOR = ("#bcbddc", "#6a51a3", 0.85)
 _SPRING = "#cb181d"
 _GROUND = "#252525"
 _BAD = "#e31a1c"
-_TOP_LAYER = 1000  # drawing order of the fan-out bars nets add to driver bodies
+_TOP_LAYER = 1000  # drawing order of the fan-out bars nets add to driver bodies (rods: + 1)
 
 
 @dataclass
@@ -241,8 +242,16 @@ def _shapes(mech, mover: _Mover, conn: dict[str, set[int]]):
             x0, y0, x1, y1 = _cell_bounds(part, conn)
             pad = 0.3 * mech.ctx.bar
             boxes[owner] = (x0 - pad, y0 - pad, x1 + pad, y1 + pad)
-    for part in mech.nets.values():  # the nets' rods, over every cell
+    for part in mech.nets.values():  # the nets' rods, over every cell and fan-out bar
+        for b in part.bodies:
+            cls = "bad" if b.id in mover.unsolved else "cn"
+            for poly in b.outline:
+                xs, ys = mover.move(b.id, [p[0] for p in poly], [p[1] for p in poly])
+                shapes.append(Shape("body", list(zip(xs.tolist(), ys.tolist())), cls, b.id,
+                                    _TOP_LAYER + 1))
         for j in part.joints:
+            if j.kind == "pin":  # a rod's pin, at the driver's (or the load's) copy of it
+                shapes.append(Shape("pin", [mover.pt(j.a, j.pa)], ref=j.id))
             shapes += joint_kind(j.kind).shapes(j, mover)
     return shapes, boxes
 

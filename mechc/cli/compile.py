@@ -81,6 +81,10 @@ def run(args: argparse.Namespace) -> int:
                   f"{h['to']}: {h['requires']}")
         for line in ordering_lines(st.get("sequential", {}).get("ordering")):
             print(f"  {line}")
+    if "planes" in st:
+        print(f"  interconnect: {st['rods']} rods, {st['rod_length_mm']:g} mm of rod, "
+              f"{st['bends']} bends, {st['planes']['count']} planes "
+              f"({', '.join(map(str, st['planes']['used']))})")
     for line in cells_used(design, load_library(args.cell_dirs)):
         print(f"  {line}")
     for net, why in st.get("amplified", {}).items():

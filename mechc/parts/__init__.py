@@ -32,14 +32,15 @@ from mechc.parts.groove import Groove
 from mechc.parts.lever import Lever
 from mechc.parts.link import Link
 from mechc.parts.pin import Pin
+from mechc.parts.pushrod import PushRod
 from mechc.parts.rod import Rod
 from mechc.parts.rotor import Rotor
 from mechc.parts.slider import Slider
 from mechc.parts.touch import Touch
 
-BODY_KINDS.update({k.name: k for k in (Slider, Lever, Link, Rotor)})
+BODY_KINDS.update({k.name: k for k in (Slider, Lever, Link, Rotor, PushRod)})
 JOINT_KINDS.update({k.name: k for k in (Groove, Rod, Contact, Pin, Touch)})
 
 __all__ = ["BODY_KINDS", "JOINT_KINDS", "BodyKind", "JointKind", "Shape", "body_kind",
            "displacement", "joint_kind", "lever_arm", "position", "Contact", "Groove", "Lever",
-           "Link", "Pin", "Rod", "Rotor", "Slider", "Touch"]
+           "Link", "Pin", "PushRod", "Rod", "Rotor", "Slider", "Touch"]

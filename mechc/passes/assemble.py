@@ -20,8 +20,19 @@ from mechc.errors import DesignError, UsageError
 from mechc.geometry.transform import bounds, translate
 from mechc.ir.check import Check
 from mechc.ir.layout import Layout
-from mechc.ir.mechanism import Demand, Joint, Mechanism, Part, Point, SynthContext, Terminal
+from mechc.ir.mechanism import (
+    Body,
+    Demand,
+    Joint,
+    Mechanism,
+    Part,
+    Point,
+    SynthContext,
+    Terminal,
+)
 from mechc.ir.netlist import Netlist
+from mechc.parts.pushrod import ROLE, PushRod, bar_outline
+from mechc.passes.route import Piece, assign_planes
 from mechc.passes.strength import size_parts
 
 
@@ -119,38 +130,8 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
         node, pin = nl.driver[net]
         return node, placed[node].terminals[pin]
 
-    nets: dict[str, Part] = {}
-    for k, names in gap_nets.items():
-        x_gap = col_x[k] + col_w[k] + channel
-        for i, net in enumerate(names):
-            owner, term = driver_of(net)
-            dpart = inputs[owner[3:]] if owner.startswith("in:") else placed[owner]
-            tx, ty = _mid(term)
-            x_bar = x_gap + i * channel
-            ys = [ty]
-            rods = Part()
-            for j, (cid, pin) in enumerate(loads[net]):
-                lt = placed[cid].terminals[pin]
-                lx, ly = _mid(lt)
-                # a load left of its driver is a feedback path (a MEMORY's state): the rod runs
-                # back over the cells between, on the net's own plane
-                if abs(lx - x_bar) < 0.5 * S:
-                    raise DesignError(f"net {net}: load {cid}.{pin} too close to its fan-out bar")
-                rods.joints.append(Joint(f"net.{net}.rod{j + 1}", "rod", term.body, lt.body,
-                                         pa=(x_bar, ly), pb=(lx, ly), length=abs(lx - x_bar)))
-                ys.append(ly)
-            body = dpart.body(term.body)
-            layers = body.poly_layers or [body.layer] * len(body.outline)
-            net_layer = 10 + i  # each fan-out of a channel on its own plane: arms may cross
-            body.outline.append(rect(tx, ty - w / 2, x_bar + w / 2, ty + w / 2))
-            body.outline.append(rect(x_bar - w / 2, min(ys) - w / 2, x_bar + w / 2,
-                                     max(ys) + w / 2))
-            body.poly_layers = layers + [net_layer, net_layer]
-            body.mass = ctx.mass(body.outline)
-            d = demand.get(net, Demand())
-            rods.data = {"driver": owner, "fanout_bar_x": round(x_bar, 3),
-                         "demand": d.to_json(), "loads": [f"{c}.{p}" for c, p in loads[net]]}
-            nets[net] = rods
+    nets = _route_nets(gap_nets, col_x, col_w, channel, loads, driver_of, inputs, placed,
+                       demand, ctx, opts)
 
     # ---- outputs and actuators --------------------------------------------------------------
     outputs: dict[str, tuple[str, str]] = {}
@@ -203,6 +184,85 @@ def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):
             add = Demand(ld["right_N"] + ctx.friction, ld["left_N"] + ctx.friction)
             demand[net] = demand.get(net, Demand()) + add
     return demand, local
+
+
+def _route_nets(gap_nets: dict[int, list[str]], col_x: list[float], col_w: list[float],
+                channel: float, loads: dict[str, list[tuple[str, str]]], driver_of,
+                inputs: dict[str, Part], placed: dict[str, Part], demand: dict[str, Demand],
+                ctx: SynthContext, opts: MechOptions) -> dict[str, Part]:
+    """Every net as parts: a fan-out bar (an arm and a vertical bar drawn onto the driver's
+    output body) in the channel after the driver's column, and per load a ``pushrod`` body of
+    plate pinned to that bar and to the load's input slider, straight and horizontal. Planes
+    from :func:`mechc.passes.route.assign_planes`; within a channel the nets with the most
+    rods running right get the slots furthest right (shorter rods)."""
+    S, w = ctx.stroke, ctx.bar
+    cell_planes = [pl for p in [*inputs.values(), *placed.values()] for b in p.bodies
+                   for pl in (b.poly_layers or [b.layer])]
+    base = max(cell_planes, default=0) + 1  # nets above every cell: rods pass over cells
+    sweep = S / 2 + ctx.overtravel * S
+    pieces: list[Piece] = []
+    plans = []
+    for k, names in sorted(gap_nets.items()):
+        x_gap = col_x[k] + col_w[k] + channel
+
+        rightward = {n: sum(1 if _mid(placed[c].terminals[p])[0] > x_gap else -1
+                            for c, p in loads[n]) for n in names}
+        for i, net in enumerate(sorted(names, key=lambda n: (rightward[n], n))):
+            owner, term = driver_of(net)
+            dpart = inputs[owner[3:]] if owner.startswith("in:") else placed[owner]
+            body = dpart.body(term.body)
+            ax = body.axis or (1.0, 0.0)
+            move = (abs(ax[0]) * sweep, abs(ax[1]) * sweep)
+            tx, ty = _mid(term)
+            x_bar = x_gap + i * channel
+            rods = []
+            for j, (cid, pin) in enumerate(loads[net]):
+                lt = placed[cid].terminals[pin]
+                lx, ly = _mid(lt)
+                # a load left of its driver is a feedback path (a MEMORY's state): the rod runs
+                # back over the cells between, on a plane no cell uses
+                if abs(lx - x_bar) < 0.5 * S:
+                    raise DesignError(f"net {net}: load {cid}.{pin} too close to its fan-out bar")
+                rid = f"net.{net}.rod{j + 1}"
+                rods.append((rid, lt, (x_bar, ly), (lx, ly)))
+                pieces.append(Piece(rid, net, (_box(bar_outline((x_bar, ly), (lx, ly), w)),),
+                                    move, True))
+            ys = [ty] + [r[2][1] for r in rods]
+            arm = rect(tx, ty - w / 2, x_bar + w / 2, ty + w / 2)
+            bar = rect(x_bar - w / 2, min(ys) - w / 2, x_bar + w / 2, max(ys) + w / 2)
+            pieces.append(Piece(f"net.{net}", net, (_box(arm), _box(bar)), move, False))
+            plans.append((net, owner, term, body, x_bar, arm, bar, rods))
+    plane = assign_planes(pieces, opts.clearance, base)
+    nets: dict[str, Part] = {}
+    for net, owner, term, body, x_bar, arm, bar, rods in plans:
+        layers = body.poly_layers or [body.layer] * len(body.outline)
+        body.outline += [arm, bar]
+        body.poly_layers = layers + [plane[f"net.{net}"]] * 2
+        body.mass = ctx.mass(body.outline)
+        part = Part()
+        info = []
+        for rid, lt, pa, pb in rods:
+            poly = bar_outline(pa, pb, w)
+            mid = ((pa[0] + pb[0]) / 2, (pa[1] + pb[1]) / 2)
+            part.bodies.append(Body(rid, PushRod.name, [poly], ctx.mass([poly]), pivot=mid,
+                                    layer=plane[rid], role=ROLE))
+            part.joints.append(Joint(f"{rid}.driver", "pin", term.body, rid, pa=pa))
+            part.joints.append(Joint(f"{rid}.load", "pin", rid, lt.body, pa=pb))
+            info.append({"body": rid, "plane": plane[rid],
+                         "length_mm": round(abs(pb[0] - pa[0]), 4), "width_mm": w,
+                         "thickness_mm": ctx.thickness, "bends": 0,
+                         "ends": "square, bar width / 2 beyond each pin centre"})
+        d = demand.get(net, Demand())
+        part.data = {"driver": owner, "fanout_bar_x": round(x_bar, 3),
+                     "fanout_plane": plane[f"net.{net}"], "demand": d.to_json(),
+                     "loads": [f"{c}.{p}" for c, p in loads[net]], "rods": info}
+        nets[net] = part
+    return nets
+
+
+def _box(poly: list[Point]) -> tuple[float, float, float, float]:
+    return (min(p[0] for p in poly), min(p[1] for p in poly), max(p[0] for p in poly),
+            max(p[1] for p in poly))
 
 
 def _mid(t: Terminal) -> Point:

@@ -146,6 +146,18 @@ def push_rods(mech: Mechanism, loads: dict[str, float] | None = None) -> list[Pu
     rods = []
     for where, part in _parts(mech):
         ends = part.data.get("loads", [])
+        if where.startswith("net ") and part.data.get("rods"):  # rods as pushrod bodies
+            pins = {j.id: j for j in part.joints}
+            for k, info in enumerate(part.data["rods"]):
+                rid = info["body"]
+                pa, pb = pins[f"{rid}.driver"].pa, pins[f"{rid}.load"].pa
+                right, left = (_share(mech, ends[k]) if k < len(ends)
+                               else (loads.get(where, 0.0),) * 2)
+                guides = int(part.data.get("rod_guides", {}).get(rid, 0))
+                rods.append(PushRod(rid, where, float(info["length_mm"]), float(info["width_mm"]),
+                                    float(info["thickness_mm"]),
+                                    right if pb[0] >= pa[0] else left, guides, True))
+            continue
         for j in part.joints:
             if j.kind != "rod" or not j.length:
                 continue

@@ -1,7 +1,8 @@
 """Kinematic evaluation of a whole mechanism: inputs -> every body's pose, vectorised.
 
 Cells are solved in topological order by their own closed forms (``Cell.kinematics``); the rods
-of each net carry a driver's output slider to its loads' input sliders.
+of each net carry a driver's output slider to its loads' input sliders, and each rod body is
+posed on the line between its two pins.
 """
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from mechc.ir.mechanism import Body, Mechanism, Terminal
+from mechc.parts.pushrod import NetRod, net_rods, pose_rod_body
 from mechc.parts.rod import slider_from_rod
 from mechc.physics.closed_form import Poses, position
 
@@ -47,10 +49,10 @@ def evaluate(mech: Mechanism, lib: CellModels, cell_types: dict[str, str],
         t = part.terminals[name]
         poses.u[t.body] = (np.asarray(values[name], dtype=float) - 0.5) * S
         poses.bad[t.body] = np.zeros(size, dtype=bool)
-    rods_to: dict[str, list] = {}
+    rods_to: dict[str, list[NetRod]] = {}
     for part in mech.nets.values():
-        for j in part.joints:
-            rods_to.setdefault(j.b, []).append(j)
+        for r in net_rods(part):
+            rods_to.setdefault(r.load, []).append(r)
     prior = {}
     for cid in mech.order:
         cls = lib[cell_types[cid]]
@@ -63,16 +65,23 @@ def evaluate(mech: Mechanism, lib: CellModels, cell_types: dict[str, str],
         part = mech.cells[cid]
         fixed = {}
         for t in part.terminals.values():
-            for j in rods_to.get(t.body, []):
+            for r in rods_to.get(t.body, []):
                 if t.body not in fixed:
-                    slider_from_rod(j, bodies[t.body], bodies[j.a], poses, size)
+                    slider_from_rod(r.as_joint(), bodies[t.body], bodies[r.driver], poses, size)
                     fixed[t.body] = poses.u[t.body]
+
         cls = lib[cell_types[cid]]
         sub = cls.kinematics(part, fixed, size, prior.get(cid))
         for b in fixed:  # carry the badness of what drives this cell
             if b in poses.bad:
                 sub.mark(b, poses.bad[b])
         poses.update(sub)
+    # the rods themselves, bodies of plate between their pins, once every cell stands where it
+    # ends (a MEMORY's output is placed first from its state, then again from its inputs)
+    for rods in rods_to.values():
+        for r in rods:
+            if r.body is not None:
+                pose_rod_body(r, bodies[r.body], bodies[r.driver], bodies[r.load], poses, size)
     return poses
 
 

@@ -8,7 +8,9 @@ kind builds its own (``mechc.parts``):
   Coulomb guide friction (a ground pivot with no position correction whose force is capped);
 - lever: a pivot joint to the ground;
 - groove: pymunk GrooveJoint (slot on body a, pin on body b);
-- rod: PinJoint of the rod's length (a massless link);
+- rod joint (inside cells): PinJoint of the rod's length (a massless link);
+- net rod: a ``pushrod`` body with the mass of its plate, pivot joints to the driver's fan-out
+  bar and the load's input slider;
 - contact: one-sided, as a SlideJoint between the face on b and a point far behind the face on a
   (distance >= that far offset means the faces have not passed each other);
 - spring: DampedSpring.
@@ -36,6 +38,7 @@ from mechc.ir.mechanism import GROUND, Body, Mechanism
 from mechc.parts import body_kind, joint_kind
 from mechc.parts.base import N
 from mechc.parts.contact import FAR
+from mechc.parts.pushrod import net_rods
 from mechc.physics.closed_form import Poses
 from mechc.physics.evaluate import CellModels, output_signals, settle
 
@@ -144,11 +147,12 @@ class Scene:
         sc._index = index
         parts = [mech.inputs[n] for n in mech.inputs] + [mech.cells[c] for c in sc.cells]
         own = {b.id for p in parts for b in p.bodies}
-        # bodies outside the scene that its rods hang on become closed-form driven
-        rods = [j for p in mech.nets.values() for j in p.joints if j.b in own]
-        for j in rods:
-            if j.a not in own:
-                sc.boundary.add(j.a)
+        # the rods to the scene's loads, and bodies outside it that they hang on (closed-form
+        # driven)
+        rods = [r for p in mech.nets.values() for r in net_rods(p) if r.load in own]
+        for r in rods:
+            if r.driver not in own:
+                sc.boundary.add(r.driver)
         if poses is None:
             poses = sc._kinematic({k: np.array([v]) for k, v in start.items()})
         else:
@@ -156,6 +160,9 @@ class Scene:
         for p in parts:
             for b in p.bodies:
                 sc._add_body(b, poses, kinematic=False)
+        for r in rods:  # rod bodies: plate with mass, pinned at both ends
+            if r.body is not None:
+                sc._add_body(index[r.body], poses, kinematic=False)
         for bid in sorted(sc.boundary):
             sc._add_body(index[bid], poses, kinematic=True)
         for cid in sc.cells:
@@ -165,8 +172,9 @@ class Scene:
             for s in p.springs:
                 sc._add_spring(s)
             lib[types[cid]].build_dynamics(sc, p)  # what the geometry alone cannot say
-        for j in rods:
-            sc._add_joint(j)
+        for r in rods:
+            for j in r.joints:
+                sc._add_joint(j)
         for name, part in mech.inputs.items():
             t = part.terminals[name]
             body = sc.bodies[t.body]
