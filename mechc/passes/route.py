@@ -8,7 +8,9 @@ the clearance of each other in any state:
 
 - pieces of one net move together (the driver's travel, carried unchanged by horizontal rods
   between horizontal sliders), so two rods of one net meet only if their outlines at the design
-  pose do; a rod and its own fan-out bar are pinned together and are not compared;
+  pose do; a rod and its own fan-out bar always conflict: the pin that joins them passes through
+  two plates, so the rod's end and the bar it is pinned to lie on different planes (a rod on its
+  bar's plane would overlap it at the pin);
 - pieces of two nets move independently along their axes by up to ``sweep`` either way, so they
   meet if their outlines, each stretched by its sweep, come within the clearance.
 
@@ -54,8 +56,8 @@ def _gap(a: Rect, b: Rect, sx: float, sy: float) -> float:
 def conflict(p: Piece, q: Piece, clearance: float) -> bool:
     """Whether ``p`` and ``q`` could come within ``clearance`` of each other in some state."""
     if p.net == q.net:
-        if p.rod != q.rod:  # a rod and its own fan-out bar: pinned together
-            return False
+        if p.rod != q.rod:  # a rod and its own fan-out bar: pinned, one plate over the other
+            return True
         sx = sy = 0.0  # one net moves as one
     else:
         sx, sy = p.sweep[0] + q.sweep[0], p.sweep[1] + q.sweep[1]
