@@ -49,6 +49,7 @@ from mechc.cells.materials import (
 )
 from mechc.ir.check import Check
 from mechc.ir.mechanism import Mechanism, Part, SynthContext
+from mechc.parts.pushrod import net_rods
 
 #: Factor of safety on the yield strength of a ductile plate (and of the steel pins).
 YIELD_SAFETY = 2.0
@@ -85,7 +86,7 @@ def euler_load(E: float, width: float, thickness: float, length: float, k: float
 
 
 @dataclass(frozen=True)
-class PushRod:
+class LoadedRod:
     """A rod as the strength checks see it: a pinned-pinned strut."""
 
     id: str
@@ -132,7 +133,7 @@ def _parts(mech: Mechanism):
     yield from ((f"net {k}", p) for k, p in sorted(mech.nets.items()))
 
 
-def push_rods(mech: Mechanism, loads: dict[str, float] | None = None) -> list[PushRod]:
+def push_rods(mech: Mechanism, loads: dict[str, float] | None = None) -> list[LoadedRod]:
     """Every rod of the mechanism (the nets' and the cells' own) with its length, cross-section
     and largest compressive load: the one place the strength checks read rods from.
 
@@ -146,17 +147,13 @@ def push_rods(mech: Mechanism, loads: dict[str, float] | None = None) -> list[Pu
     rods = []
     for where, part in _parts(mech):
         ends = part.data.get("loads", [])
-        if where.startswith("net ") and part.data.get("rods"):  # rods as pushrod bodies
-            pins = {j.id: j for j in part.joints}
-            for k, info in enumerate(part.data["rods"]):
-                rid = info["body"]
-                pa, pb = pins[f"{rid}.driver"].pa, pins[f"{rid}.load"].pa
+        if where.startswith("net "):  # a net's rods, pin to pin (pushrod bodies, or the
+            for k, r in enumerate(net_rods(part)):  # rod joints of an earlier version)
                 right, left = (_share(mech, ends[k]) if k < len(ends)
                                else (loads.get(where, 0.0),) * 2)
-                guides = int(part.data.get("rod_guides", {}).get(rid, 0))
-                rods.append(PushRod(rid, where, float(info["length_mm"]), float(info["width_mm"]),
-                                    float(info["thickness_mm"]),
-                                    right if pb[0] >= pa[0] else left, guides, True))
+                guides = int(part.data.get("rod_guides", {}).get(r.id, 0))
+                rods.append(LoadedRod(r.id, where, float(r.length), ctx.bar, ctx.thickness,
+                                    right if r.pb[0] >= r.pa[0] else left, guides, True))
             continue
         for j in part.joints:
             if j.kind != "rod" or not j.length:
@@ -167,12 +164,12 @@ def push_rods(mech: Mechanism, loads: dict[str, float] | None = None) -> list[Pu
                 right, left = _share(mech, ends[part.joints.index(j)])
                 load = right if j.pb[0] >= j.pa[0] else left
             guides = int(part.data.get("rod_guides", {}).get(j.id, 0)) if net_rod else 0
-            rods.append(PushRod(j.id, where, float(j.length), ctx.bar, ctx.thickness, load,
+            rods.append(LoadedRod(j.id, where, float(j.length), ctx.bar, ctx.thickness, load,
                                 guides, net_rod))
     return rods
 
 
-def guides_needed(rod: PushRod, E: float) -> int:
+def guides_needed(rod: LoadedRod, E: float) -> int:
     """Fewest guides that keep every span of a translating rod within its Euler length at
     ``BUCKLING_SAFETY``: L_max = pi sqrt(E I / (3 P)); none for a rod that holds as it is."""
     if not rod.guidable or rod.load <= 0.0:
