@@ -338,3 +338,19 @@ def test_clearance_out_of_range_is_a_usage_error(cli, tmp_path):
     out = tmp_path / "x.json"
     got, _, err = cli("compile", EXAMPLES / "sorter.bool", "--clearance", "-1", "-o", out)
     assert got == 2 and "--clearance" in err and not out.exists()
+
+
+def test_pairs_sharing_a_plane_counts_without_listing_pairs():
+    """The stats' count of body pairs on one plane, against listing every pair (bodies on one
+    plane and bodies on several, as a driver with its fan-out bar is)."""
+    import itertools
+
+    from mechc.physics.interference import pairs_sharing_a_plane
+
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        layers = [frozenset(int(x) for x in rng.choice(8, size=int(rng.choice([1, 1, 1, 2, 3])),
+                                                       replace=False))
+                  for _ in range(int(rng.integers(0, 40)))]
+        brute = sum(1 for a, b in itertools.combinations(layers, 2) if a & b)
+        assert pairs_sharing_a_plane(layers) == brute

@@ -306,23 +306,42 @@ class Interference:
         """Counts for the design's stats: pairs of bodies sharing a plane, those exempt
         (``bearing``) or abutting, those measured exactly (``near``), those failing."""
         if self._counts is None:
-            ids = {bid: k for k, bid in enumerate(self.bodies)}
-            codes = []
-            for layer in np.unique(self._layer_arr):
-                members = np.unique(self._body_arr[self._layer_arr == layer])
-                i, j = np.triu_indices(len(members), 1)
-                codes.append(members[i] * len(ids) + members[j])
-            same = np.unique(np.concatenate(codes)) if codes else np.zeros(0, np.int64)
-            kinds = {"bearing": [], "abut": []}
+            layers: dict[str, frozenset[int]] = {}
+            for b, lay in zip(self._poly_body, self._poly_layer):
+                layers[b] = layers.get(b, frozenset()) | {int(lay)}
+            kinds = {"bearing": 0, "abut": 0}
             for pair, kind in self.exempt.items():
-                if all(x in ids for x in pair):
-                    a, b = sorted(ids[x] for x in pair)
-                    kinds[kind].append(a * len(ids) + b)
-            self._counts = {"pairs_on_one_plane": int(len(same)),
-                            "bearing_pairs": int(np.isin(kinds["bearing"], same).sum()),
-                            "abutting_pairs": int(np.isin(kinds["abut"], same).sum())}
+                a, b = tuple(pair)
+                if a in layers and b in layers and layers[a] & layers[b]:
+                    kinds[kind] += 1
+            self._counts = {"pairs_on_one_plane": pairs_sharing_a_plane(list(layers.values())),
+                            "bearing_pairs": kinds["bearing"], "abutting_pairs": kinds["abut"]}
         return {"clearance_mm": self.clearance, "states": self.states, **self._counts,
                 "near_pairs": len(self.results), "failed_pairs": len(self.failing())}
+
+
+def pairs_sharing_a_plane(layers: list[frozenset[int]]) -> int:
+    """How many pairs of bodies share at least one plane, counted without listing the pairs
+    (a big design has thousands of bodies on the cells' planes: millions of pairs). Bodies on
+    one plane count C(n, 2) per plane; the few on several planes (a driver with its fan-out
+    bar) are counted against every body on each of their planes, once per pair."""
+    single: dict[int, int] = {}
+    multi = [ls for ls in layers if len(ls) > 1]
+    for ls in layers:
+        if len(ls) == 1:
+            (lay,) = ls
+            single[lay] = single.get(lay, 0) + 1
+    count = sum(n * (n - 1) // 2 for n in single.values())
+    count += sum(single.get(lay, 0) for ls in multi for lay in ls)
+    if multi:
+        planes = sorted(set().union(*multi))
+        col = {lay: k for k, lay in enumerate(planes)}
+        m = np.zeros((len(multi), len(planes)), dtype=np.float32)
+        for i, ls in enumerate(multi):
+            m[i, [col[lay] for lay in ls]] = 1.0
+        share = (m @ m.T) > 0
+        count += int(np.triu(share, 1).sum())
+    return count
 
 
 def overlap_depth(inter: np.ndarray) -> np.ndarray:
