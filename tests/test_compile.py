@@ -92,8 +92,21 @@ def test_sorter_netlist_is_the_dissertations_circuit(cli, tmp_path):
 @pytest.mark.parametrize("seed", range(16))
 @pytest.mark.parametrize("fmt", ["bool", "pla"])
 def test_random_specs_compile_to_equivalent_netlists(cli, tmp_path, seed, fmt):
+    """4 to 8 inputs: a whole compile each (mechanism, design checks, the JSON validated); the
+    wide ones, whose designs run to a thousand cells and tens of MB, are the test below."""
+    _random_spec_round_trip(cli, tmp_path, seed, fmt, (4, 9))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed, fmt", [(3, "bool"), (7, "pla")])
+def test_wide_random_specs_compile_to_equivalent_netlists(cli, tmp_path, seed, fmt):
+    """9 or 10 inputs (a 10-input random function compiles to over 1600 cells)."""
+    _random_spec_round_trip(cli, tmp_path, seed + 1000, fmt, (9, 11))
+
+
+def _random_spec_round_trip(cli, tmp_path, seed, fmt, inputs):
     rng = np.random.default_rng(seed + (0 if fmt == "bool" else 500))
-    n = int(rng.integers(4, 11))
+    n = int(rng.integers(*inputs))
     m = int(rng.integers(1, 5))
     names = [f"i{k}" for k in range(n)]
     tables = {f"o{j}": random_table(rng, n, float(rng.uniform(0.05, 0.5)),
