@@ -52,7 +52,10 @@ from mechc.physics.scene import FAR, N
 #: and DynSettings: stroke 20 mm, rollers at 60 rad/s) and re-measured by
 #: tests/test_amplifier.py; stored in every instance's part.data for the mapper and the
 #: sequential proof. Delay: input at 95 % of its stroke -> output within 5 % of its new end
-#: (worst of on and off). Fan-out: OR inputs driven with prove_dynamic passing (4 fails).
+#: (worst of on and off). Fan-out: OR inputs driven with prove_dynamic passing. With massless
+#: rods 4 failed; since the nets' rods are bodies with mass the benchmark passes up to 6 (its
+#: --kmax): 3 is kept, a conservative limit the mapper splits fan-outs by, until the splitting
+#: is re-derived from the new measurement.
 MEASURED = {
     "switching_delay_s": 0.048,
     "fanout_max": 3,
