@@ -28,7 +28,6 @@ the dynamic walk decides; the inequality sizes the delay.
 from __future__ import annotations
 
 import math
-from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -50,7 +49,7 @@ from mechc.ir.seqspec import (
 from mechc.passes.amplify import amplifier_cell, amplify_nets
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.scene import DynSettings
-from mechc.proofs.seq_logic import SeqNetlist, X, _moved, _reachable, ternary_transition
+from mechc.proofs.seq_logic import SeqNetlist, X, _moved, _reachable, path_to, ternary_transition
 from mechc.proofs.settings import MEMORY_THROW_S, dyn_settings
 
 #: The time an ordering inequality must hold by (s): a quarter of the default input move.
@@ -243,7 +242,7 @@ def tour_of(spec: SeqSpec, wanted: set[tuple[int, object, int]]) -> list[list[di
                 cur = next(v for xx, v in g.edges[cur] if xx == x2)
                 seq.append(x2)
                 continue
-            path = _path_to(g, cur, {node for node, _ in untaken})
+            path = path_to(g, cur, {node for node, _ in untaken})
             if path is None:
                 break
             for x2, node in path:
@@ -255,25 +254,6 @@ def tour_of(spec: SeqSpec, wanted: set[tuple[int, object, int]]) -> list[list[di
     n = spec.n
     return [[{name: (x >> (n - 1 - k)) & 1 for k, name in enumerate(spec.inputs)} for x in s]
             for s in seqs]
-
-
-def _path_to(g, cur, targets):
-    prev = {cur: None}
-    todo = deque([cur])
-    while todo:
-        u = todo.popleft()
-        if u in targets and u != cur:
-            path = []
-            while prev[u] is not None:
-                p, x2 = prev[u]
-                path.append((x2, u))
-                u = p
-            return path[::-1]
-        for x2, v in g.edges.get(u, []):
-            if v not in prev:
-                prev[v] = (u, x2)
-                todo.append(v)
-    return None
 
 
 def verify_requirements(design: Design, lib: Library, reqs: list[Requirement],

@@ -419,7 +419,7 @@ def transition_tour(spec: SeqSpec, seed: int = 0, random_walks: int = 0,
                 x2, cur = g.edges[cur][mine[0]]
                 seq.append(x2)
                 continue
-            path = _path_to_untaken(g, cur, untaken)
+            path = path_to(g, cur, {u for (u, _i) in untaken})
             if path is None:
                 break
             for x2, node in path:
@@ -447,8 +447,11 @@ def transition_tour(spec: SeqSpec, seed: int = 0, random_walks: int = 0,
             for s in seqs]
 
 
-def _path_to_untaken(g, cur, untaken):
-    has = {u for (u, _i) in untaken}
+def path_to(g, cur, targets):
+    """Shortest input sequence from state ``cur`` to any state of ``targets`` (breadth first
+    over the transition graph ``g``), as (input column, state) steps; None if none is
+    reachable."""
+    has = targets
     prev = {cur: None}
     todo = deque([cur])
     while todo:
