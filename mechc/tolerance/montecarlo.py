@@ -19,6 +19,7 @@ import numpy as np
 from mechc.cells.library import Library
 from mechc.errors import UsageError
 from mechc.ir.design import Design
+from mechc.ir.spec import Spec
 from mechc.tolerance.batch import Batch, CheckKey
 from mechc.tolerance.dimensions import Dim, dimensions
 from mechc.tolerance.sensitivity import Ranked, by_owner, jacobian, lost_motion, rank
@@ -107,7 +108,7 @@ def prepare(design: Design, lib: Library, s: ToleranceSettings):
     """The batch solver of ``design`` with its pins' lost motion, and the derivatives."""
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
-    if design.sequential is not None:
+    if design.sequential is not None or not isinstance(design.spec, Spec):
         raise UsageError("a tolerance run proves combinational designs (every input state and "
                          "single-input change); this design is sequential")
     states = proof_states(design.spec)
