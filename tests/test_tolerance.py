@@ -46,6 +46,9 @@ def test_yield_agrees_with_designs_proven_one_by_one(sorter, tmp_path):
     s = ToleranceSettings(tol=0.1, clearance=0.0, spring_tol=0.1, samples=400, seed=3)
     dims = dimensions(design.mechanism)
     X = draw(dims, s)
+    # a design file cannot hold a net rod's length apart from its two pins (the rod is drawn
+    # between them), so the nets' dimensions stay nominal in this comparison
+    X[:, [k for k, d in enumerate(dims) if d.part.startswith("net:")]] = 0.0
     result = run(design, lib, s, deltas=X)
     assert 0.3 < result.yield_ < 0.95  # a mix of passes and failures to agree on
     n = 30
@@ -98,7 +101,14 @@ def test_sensitivity_ranks_the_rest_stop_high_and_an_outline_last(sorter):
                 and j.b == "c6.bar")
     key = f"{stop.id}.pa.x"
     assert effect[key] == pytest.approx(0.1, abs=1e-6)  # moves the rest 1:1
-    assert names.index(key) < len(names) // 4
+    # near the top: within 1 % of the largest effect, and only the NOT levers' rods (which
+    # the levers amplify by 0.6 %) ahead of it; many dimensions tie with it (every face a bar
+    # rests on moves it 1:1)
+    top = max(effect.values())
+    assert effect[key] >= 0.99 * top
+    ahead = [n for n, v in effect.items() if v > effect[key] + 1e-9]
+    assert len(ahead) < len(names) // 20 and all(n.split(".")[1].startswith("rod")
+                                                  for n in ahead), ahead
     # an outline (plate beyond the pins) and a stop face's coordinate along the face move
     # nothing: ranked after every dimension that does
     for dead in ("c6.bar.outline", f"{stop.id}.pa.y"):

@@ -20,6 +20,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from mechc.ir.mechanism import GROUND, Body, Joint, Mechanism, Part, Spring
+from mechc.parts.pushrod import net_rods
 
 #: joint attributes that are points, and whether the point is a pin's centre (clearance)
 POINT_ATTRS = ("p0", "p1", "q", "pa", "pb")
@@ -61,6 +62,8 @@ def dimensions(mech: Mechanism) -> list[Dim]:
     """Every dimension of ``mech``, in a stable order (parts, then their bodies, joints and
     springs in the order the design lists them)."""
     dims: list[Dim] = []
+    rod_length = {r.body: float(r.length) for part in mech.nets.values()
+                  for r in net_rods(part) if r.body is not None}
     for key, owner, part in _parts(mech):
         for i, b in enumerate(part.bodies):
             if b.kind == "lever" and b.pivot is not None:
@@ -71,6 +74,9 @@ def dimensions(mech: Mechanism) -> list[Dim]:
             if b.outline:
                 dims.append(Dim(f"{b.id}.outline", owner, "outline", "mm", 0.0, key, "body", i,
                                 "outline", -1))
+            if b.id in rod_length:  # a net's rod: its holes' spacing, cut apart from the pins
+                dims.append(Dim(f"{b.id}.length", owner, "rod length", "mm", rod_length[b.id],
+                                key, "body", i, "length", -1))
         for i, j in enumerate(part.joints):
             if j.kind == "touch":  # a cam or roller: its cell's own kinematics (not modelled)
                 continue
@@ -112,28 +118,17 @@ def perturb(mech: Mechanism, dims: list[Dim], delta, springs: bool = True,
     ``springs=False`` leaves the springs nominal: the closed forms read a spring only for the
     direction it pulls, so a tolerance run measures spring forces from the same deltas itself
     (``mechc.tolerance.batch``) instead of carrying them through the solve. Outlines are
-    changed only in a scalar copy (a design to write): no closed form reads them.
+    changed only in a scalar copy (a design to write): no closed form reads them. A net rod's
+    length is not held by a design file apart from its pins (the rod is the line between them):
+    only the tolerance run's batch applies it (``mechc.tolerance.batch.Batch``).
     ``absolute``: ``delta`` holds the new values themselves (nominal plus delta, made by the
     caller in one pass), not changes."""
-    by_obj: dict[tuple[str, str, int], list[tuple[Dim, object]]] = {}
+    by_part: dict[str, list[tuple[Dim, object]]] = {}
     for d, v in zip(dims, delta):
-        by_obj.setdefault((d.part, d.obj, d.index), []).append((d, v))
-    scalar = all(np.ndim(v) == 0 for v in delta)
+        by_part.setdefault(d.part, []).append((d, v))
 
     def new_part(key: str, part: Part) -> Part:
-        bodies = list(part.bodies)
-        joints = list(part.joints)
-        sprs = list(part.springs)
-        for (pk, obj, i), changes in by_obj.items():
-            if pk != key:
-                continue
-            if obj == "body":
-                bodies[i] = _body(bodies[i], changes, scalar, absolute)
-            elif obj == "joint":
-                joints[i] = _changed(joints[i], changes, absolute)
-            elif springs:
-                sprs[i] = _spring(sprs[i], changes)
-        return Part(bodies, joints, sprs, part.terminals, part.data)
+        return perturb_part(part, by_part.get(key, []), springs, absolute)
 
     return Mechanism(mech.ctx,
                      {c: new_part(f"cell:{c}", p) for c, p in mech.cells.items()},
@@ -142,12 +137,35 @@ def perturb(mech: Mechanism, dims: list[Dim], delta, springs: bool = True,
                      mech.outputs, mech.actuators, mech.order, mech.checks)
 
 
+def perturb_part(part: Part, changes: list[tuple[Dim, object]], springs: bool = True,
+                 absolute: bool = False) -> Part:
+    """One part with its dimensions changed (``changes``: the part's dimensions and their
+    deltas, or new values with ``absolute``); see :func:`perturb`."""
+    if not changes:
+        return part
+    scalar = all(np.ndim(v) == 0 for _, v in changes)
+    by_obj: dict[tuple[str, int], list[tuple[Dim, object]]] = {}
+    for d, v in changes:
+        by_obj.setdefault((d.obj, d.index), []).append((d, v))
+    bodies = list(part.bodies)
+    joints = list(part.joints)
+    sprs = list(part.springs)
+    for (obj, i), ch in by_obj.items():
+        if obj == "body":
+            bodies[i] = _body(bodies[i], ch, scalar, absolute)
+        elif obj == "joint":
+            joints[i] = _changed(joints[i], ch, absolute)
+        elif springs:
+            sprs[i] = _spring(sprs[i], ch)
+    return Part(bodies, joints, sprs, part.terminals, part.data)
+
+
 def _changed(obj, changes: list[tuple[Dim, object]], absolute: bool = False):
     """A copy of a body or joint with its points' components and scalars moved."""
     new: dict[str, object] = {}
     for d, v in changes:
-        if d.attr == "outline":
-            continue
+        if d.attr in ("outline", "length") and d.obj == "body":
+            continue  # an outline: below; a net rod's length: carried by the batch (its rod)
         if d.comp < 0:
             new[d.attr] = v if absolute else getattr(obj, d.attr) + v
         else:

@@ -38,7 +38,7 @@ class ToleranceSettings:
     seed: int = 0
     proof_tolerance: float = 0.05  # fraction of stroke an output may sit from its position
     yield_level: float = 0.99  # the structural error's margin is quoted at this yield
-    chunk_states: int = 1 << 15  # samples x states solved in one evaluation
+    chunk_states: int = 1 << 16  # samples x states solved in one evaluation
 
     def check(self) -> None:
         for name, v in (("--tol", self.tol), ("--clearance", self.clearance),

@@ -82,11 +82,15 @@ def rank(jac: Jacobian, tols: np.ndarray, stroke: float, deltas: np.ndarray | No
     coef = np.zeros(D)
     if deltas is not None and margin is not None and len(margin) > 2:
         ok = np.isfinite(margin)
+        if ok.sum() < 3:
+            ok[:] = False  # nothing to regress on: every sample unsolvable somewhere
         X = deltas[ok]
-        used = np.flatnonzero(X.std(axis=0) > 0)
+        used = np.flatnonzero(X.std(axis=0) > 0) if len(X) else np.array([], int)
         if len(used) and ok.sum() > len(used) + 1:
+            # normal equations: the deltas are drawn independently, so X'X is well conditioned
+            # (and a D x D solve is far cheaper than a QR of the N x D samples)
             A = np.hstack([X[:, used], np.ones((X.shape[0], 1))])
-            b, *_ = np.linalg.lstsq(A, margin[ok], rcond=None)
+            b = np.linalg.solve(A.T @ A + 1e-12 * np.eye(A.shape[1]), A.T @ margin[ok])
             coef[used] = b[:-1] * tols[used]
     order = sorted(range(D), key=lambda k: (-pos[k], -abs(coef[k]), k))
     return [Ranked(jac.dims[k], float(pos[k]), float(coef[k])) for k in order]
