@@ -176,3 +176,25 @@ def test_bad_files_exit_2(sorter, tmp_path, cli):
     seq = _compile("toggle.fsm", tmp_path / "toggle.json")
     code, _, err = cli("tolerance", seq, "--samples", "5")
     assert code == 2 and "sequential" in err and "toggle.json" in err
+
+
+@pytest.mark.slow
+def test_robust_compile_meets_the_yield_it_reports(tmp_path, cli):
+    """mechc compile --tol 0.1 --yield 0.99 on the sorter: what it writes reaches the yield in
+    an independent run (another seed, more samples), and it says what it changed."""
+    out = tmp_path / "robust.json"
+    code, text, err = cli("compile", EXAMPLES / "sorter.bool", "-o", out, "--tol", "0.1",
+                          "--yield", "0.99", "--tol-samples", "1000")
+    assert code == 0, err
+    assert "target met" in text and "spring margin 1.3 ->" in text
+    design, lib = _load(out)
+    assert design.mechanism.ctx.margin > 1.3  # written into the design's rules
+    r = run(design, lib, ToleranceSettings(tol=0.1, clearance=0.05, spring_tol=0.1,
+                                           samples=3000, seed=11))
+    assert r.ci[1] >= 0.99 and r.yield_ >= 0.985
+
+
+def test_robust_compile_refuses_a_sequential_spec(tmp_path, cli):
+    code, _, err = cli("compile", EXAMPLES / "toggle.fsm", "-o", tmp_path / "t.json", "--tol",
+                       "0.1")
+    assert code == 2 and "sequential" in err and not (tmp_path / "t.json").exists()

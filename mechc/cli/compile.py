@@ -15,6 +15,7 @@ from mechc.backends.design_json import (
 )
 from mechc.cells.library import Library, load_library
 from mechc.cli.common import by_type, check_output, compile_options, compile_path
+from mechc.cli.tolerance import robust_design, robust_options, wants_robust
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 from mechc.frontends import SPEC_SUFFIXES
 from mechc.ir.design import Design
@@ -35,6 +36,7 @@ def register(sub) -> None:
                    "from run to run)")
     c.add_argument("--print-netlist", action="store_true",
                    help="also print the netlist in canonical text form")
+    robust_options(c)
     c.set_defaults(func=run)
 
 
@@ -42,7 +44,8 @@ def run(args: argparse.Namespace) -> int:
     out = args.output or str(Path(args.spec).with_suffix(".json"))
     check_output(out, "output", [("spec", args.spec)])
     t0 = time.perf_counter()
-    design = compile_path(args.spec, args)
+    robust = wants_robust(args)
+    design, met = robust_design(args) if robust else (compile_path(args.spec, args), True)
     obj = design_to_json(design, timings=args.timings)
     try:  # the same checks simulate and draw make on reading it, before anything is written
         check_design(obj, out)
@@ -101,7 +104,7 @@ def run(args: argparse.Namespace) -> int:
     if dc:
         print(f"  design checks: {dc['count']} passed (min transmission angle "
               f"{dc['min_transmission_angle_deg']}°)")
-    return EXIT_OK
+    return EXIT_OK if met else EXIT_FAILED
 
 
 def cells_used(design: Design, lib: Library) -> list[str]:

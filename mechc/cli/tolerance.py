@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 from pathlib import Path
 
@@ -14,13 +15,17 @@ from mechc.backends.design_json import (
     load_design_json,
     write_atomic,
 )
+from mechc.cells.library import load_library
 from mechc.cells.sources import library_for_design
-from mechc.cli.common import check_output
+from mechc.cli.common import check_output, options_from_args
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
+from mechc.frontends import load_spec
+from mechc.ir.spec import Spec
 from mechc.tolerance.montecarlo import ToleranceSettings, run
 from mechc.tolerance.process import PROCESSES, process
 from mechc.tolerance.report import summary, to_json
-from mechc.ui import Progress, finite_float, int_at_least
+from mechc.tolerance.robust import robust_compile
+from mechc.ui import Progress, finite_float, int_at_least, table
 
 
 def register(sub) -> None:
@@ -126,3 +131,76 @@ def _chart(result, path: str, title: str) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+# ---- mechc compile --tol MM --yield F -----------------------------------------------------
+
+def robust_options(c: argparse.ArgumentParser) -> None:
+    """``mechc compile``'s options for robust design (this module keeps them with the
+    tolerance command's)."""
+    g = c.add_argument_group(
+        "robust design (combinational specs)",
+        "with --tol or --process, compile, measure the yield by a tolerance run and change "
+        "spring margins, over-travel stops and the stroke until it reaches --yield; the rounds "
+        "and what changed are printed (exit 1 if the yield is not reached)")
+    g.add_argument("--tol", type=finite_float, default=None, metavar="MM",
+                   help="every dimension +-MM: design for it")
+    g.add_argument("--process", choices=list(PROCESSES), default=None,
+                   help="design for a process's tolerances (see mechc tolerance --help)")
+    g.add_argument("--yield", dest="yield_level", type=finite_float, default=0.99,
+                   metavar="F", help="target yield (default: %(default)s)")
+    g.add_argument("--pin-clearance", type=finite_float, default=None, metavar="MM",
+                   help="diametral play of every pin (default 0.05, or the process's)")
+    g.add_argument("--spring-tol", type=finite_float, default=None, metavar="FRACTION",
+                   help="springs' rate and preload +-FRACTION (default 0.1)")
+    g.add_argument("--tol-samples", type=int_at_least(100), default=2000, metavar="N",
+                   help="Monte Carlo samples per round (default: %(default)s)")
+
+
+def wants_robust(args: argparse.Namespace) -> bool:
+    return args.tol is not None or args.process is not None
+
+
+def robust_design(args: argparse.Namespace):
+    """The design ``mechc compile --tol`` writes, and whether it met the yield; prints the
+    rounds."""
+    base = process(args.process) if args.process else None
+    pick = lambda v, p, d: v if v is not None else (p if base is not None else d)  # noqa: E731
+    s = ToleranceSettings(tol=pick(args.tol, base and base.tol, 0.1),
+                          clearance=pick(args.pin_clearance, base and base.clearance, 0.05),
+                          spring_tol=pick(args.spring_tol, base and base.spring_tol, 0.1),
+                          samples=args.tol_samples, yield_level=args.yield_level)
+    s.check()
+    spec = load_spec(args.spec)
+    if not isinstance(spec, Spec):
+        raise UsageError(f"{args.spec}: --tol designs combinational specs; a sequential "
+                         "design's tolerance run is not built yet")
+    opts = options_from_args(args)
+    lib = load_library(opts.cell_dirs)
+    design, rounds, met = robust_compile(spec, opts, lib, s,
+                                         lambda line: print(f"  tolerance round: {line}",
+                                                            file=sys.stderr))
+    rows = [(i + 1, f"{r.stroke:g}", f"{r.spring_margin:.3g}", f"{r.overtravel:.0%}",
+             f"{r.result.yield_:.2%}",
+             f"[{r.result.ci[0]:.2%}, {r.result.ci[1]:.2%}]",
+             r.result.failing[0].key.name + " at " + r.result.failing[0].key.where
+             if r.result.failing else "none") for i, r in enumerate(rounds)]
+    print(f"robust design for +-{s.tol} mm, pin clearance {s.clearance} mm, springs "
+          f"+-{s.spring_tol:.0%}, target yield {s.yield_level:.2%} ({s.samples} samples a "
+          "round):")
+    print(table(rows, ["round", "stroke mm", "spring margin", "over-travel", "yield",
+                       "95 % interval", "most frequent failure"]))
+    for i, r in enumerate(rounds):
+        if r.change:
+            print(f"  after round {i + 1}: {r.change}")
+    last = rounds[-1]
+    if met:
+        print(f"  target met: stroke {last.stroke:g} mm, spring margin {last.spring_margin:.3g}"
+              f", over-travel {last.overtravel:.0%} of stroke")
+    else:
+        f = last.result.failing[0] if last.result.failing else None
+        print(f"  TARGET NOT MET: yield {last.result.yield_:.2%}"
+              + (f"; {f.key.name} at {f.key.where} fails in {f.count} samples (worst "
+                 f"{f.worst:.4g}{f.key.unit}), which this loop does not change" if f else ""),
+              file=sys.stderr)
+    return design, met
