@@ -4,6 +4,12 @@ dimension that matters most for every combinational example (docs/tolerance.md's
 
     python benchmarks/tolerance.py [--samples 10000] [--chart tolerance_sorter.png]
     python benchmarks/tolerance.py --markdown [--samples 2000]
+    python benchmarks/tolerance.py --scale [--samples 500] [--chart tolerance_scale.png]
+
+``--scale`` (how small can it be): for each process preset (mechc/tolerance/process.py), the
+yield of each example compiled at strokes from 5 to 40 mm, with the springs and over-travel
+stops robust design chose for the sorter (margin 1.46, 4 %), the smallest stroke that keeps
+99 %, and a chart of yield against stroke.
 """
 
 from __future__ import annotations
@@ -93,17 +99,85 @@ def markdown(samples: int, tol: float, clearance: float, spring_tol: float) -> N
                   f"±{spread:.3f} mm |")
 
 
+SCALE_EXAMPLES = ["sorter.bool", "full_adder.bool", "comparator2.bool", "majority.pla"]
+STROKES = [5.0, 7.5, 10.0, 15.0, 20.0, 30.0, 40.0]
+
+
+def scale(samples: int, chart: str | None, target: float = 0.99) -> None:
+    # imported here: only this study compiles in memory with chosen rules
+    from mechc.cells.library import load_library
+    from mechc.frontends import load_spec
+    from mechc.passes.assemble import MechOptions
+    from mechc.pipeline import CompileOptions, compile_spec
+    from mechc.tolerance.process import PROCESSES
+
+    lib = load_library(())
+    yields: dict[tuple[str, str], list[float]] = {}
+    for spec_name in SCALE_EXAMPLES:
+        spec = load_spec(ROOT / "examples" / spec_name)
+        for stroke in STROKES:
+            opts = CompileOptions(mech=MechOptions(stroke=stroke, spring_margin=1.46,
+                                                   overtravel=0.04))
+            d = compile_spec(spec, opts, lib)
+            for p in PROCESSES.values():
+                r = run(d, lib, ToleranceSettings(tol=p.tol, clearance=p.clearance,
+                                                  spring_tol=p.spring_tol, samples=samples))
+                yields.setdefault((p.name, spec_name), []).append(r.yield_)
+    print("| process | tolerance / pin clearance | "
+          + " | ".join(f"`{e}`" for e in SCALE_EXAMPLES) + " |")
+    print("|---|---|" + "---|" * len(SCALE_EXAMPLES))
+    for p in PROCESSES.values():
+        cells = []
+        for e in SCALE_EXAMPLES:
+            ys = yields[(p.name, e)]
+            ok = [s for s, y in zip(STROKES, ys) if y >= target]
+            smallest = next((s for i, s in enumerate(STROKES)
+                             if all(y >= target for y in ys[i:])), None)
+            cells.append(f"{smallest:g} mm" if smallest is not None
+                         else f"none up to {STROKES[-1]:g} mm (best {max(ys):.1%})"
+                         if not ok else f"{min(ok):g} mm (not all above)")
+        print(f"| {p.name} | ±{p.tol} mm / {p.clearance} mm | " + " | ".join(cells) + " |")
+    print()
+    print("yield by stroke (mm): " + ", ".join(f"{s:g}" for s in STROKES))
+    for (proc, e), ys in yields.items():
+        print(f"  {proc:5s} {e:18s} " + " ".join(f"{y:7.2%}" for y in ys))
+    if chart:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, axes = plt.subplots(1, len(PROCESSES), figsize=(5 * len(PROCESSES), 4),
+                                 sharey=True)
+        for ax, p in zip(axes, PROCESSES.values()):
+            for e in SCALE_EXAMPLES:
+                ax.plot(STROKES, [100 * y for y in yields[(p.name, e)]], marker="o", label=e)
+            ax.axhline(100 * target, color="grey", lw=0.8, ls="--")
+            ax.set_xscale("log")
+            ax.set_xticks(STROKES, [f"{s:g}" for s in STROKES])
+            ax.set_xlabel("stroke (mm); every part scales with it")
+            ax.set_title(f"{p.name}: ±{p.tol} mm, pins {p.clearance} mm, springs "
+                         f"±{p.spring_tol:.0%}", fontsize=9)
+        axes[0].set_ylabel(f"yield (%), {samples} samples")
+        axes[0].legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(chart, dpi=110)
+        print(f"chart: {chart}")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--samples", type=int, default=None)
     p.add_argument("--chart", default="tolerance_sorter.png")
     p.add_argument("--markdown", action="store_true")
+    p.add_argument("--scale", action="store_true")
     p.add_argument("--tol", type=float, default=0.1)
     p.add_argument("--clearance", type=float, default=0.05)
     p.add_argument("--spring-tol", type=float, default=0.1)
     a = p.parse_args()
-    if a.markdown:
+    if a.scale:
+        scale(a.samples or 500, a.chart if a.chart != "tolerance_sorter.png"
+              else "tolerance_scale.png")
+    elif a.markdown:
         markdown(a.samples or 2000, a.tol, a.clearance, a.spring_tol)
     else:
         speed(a.samples or 10_000, a.chart)
