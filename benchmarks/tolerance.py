@@ -143,6 +143,7 @@ def scale(samples: int, chart: str | None, target: float = 0.99) -> None:
         print(f"  {proc:5s} {e:18s} " + " ".join(f"{y:7.2%}" for y in ys))
     if chart:
         import matplotlib
+        import matplotlib.ticker
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
         fig, axes = plt.subplots(1, len(PROCESSES), figsize=(5 * len(PROCESSES), 4),
@@ -153,6 +154,7 @@ def scale(samples: int, chart: str | None, target: float = 0.99) -> None:
             ax.axhline(100 * target, color="grey", lw=0.8, ls="--")
             ax.set_xscale("log")
             ax.set_xticks(STROKES, [f"{s:g}" for s in STROKES])
+            ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
             ax.set_xlabel("stroke (mm); every part scales with it")
             ax.set_title(f"{p.name}: ±{p.tol} mm, pins {p.clearance} mm, springs "
                          f"±{p.spring_tol:.0%}", fontsize=9)

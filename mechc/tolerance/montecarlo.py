@@ -75,6 +75,7 @@ class ToleranceResult:
     ranked: list[Ranked]
     per_owner: dict[str, float]
     sample_pass: np.ndarray  # (N,) bool
+    fails: dict[str, np.ndarray] = field(default_factory=dict)  # check name -> (N,) failed
     seconds: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -132,6 +133,7 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     N = X.shape[0]
     per = max(1, s.chunk_states // batch.states.size)
     passes, margins = [], []
+    fails: dict[str, list[tuple[int, np.ndarray]]] = {}
     fail_count: dict[CheckKey, int] = {}
     fail_worst: dict[CheckKey, float] = {}
     rest_pos: dict[str, list[np.ndarray]] = {}
@@ -145,6 +147,7 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
             ok &= p
             bad = ~p
             if bad.any():
+                fails.setdefault(key.name, []).append((start, bad))
                 fail_count[key] = fail_count.get(key, 0) + int(bad.sum())
                 vv = v[bad]
                 vv = np.where(np.isnan(vv), -np.inf if key.sense == ">=" else np.inf, vv)
@@ -164,6 +167,12 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     sample_pass = np.concatenate(passes)
     margin = np.concatenate(margins)
     k = int(sample_pass.sum())
+    by_name = {}
+    for name, parts in fails.items():
+        m = np.zeros(N, dtype=bool)
+        for at, bad in parts:
+            m[at:at + len(bad)] |= bad
+        by_name[name] = m
     failing = sorted((Failing(key, c, fail_worst[key]) for key, c in fail_count.items()),
                      key=lambda f: (-f.count, f.key.name, f.key.where))
     nominal = batch.run(np.zeros((1, len(dims))))
@@ -175,6 +184,6 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     t3 = time.perf_counter()
     return ToleranceResult(
         s, dims, N, k, wilson(k, N), failing, nominal_margin, structural, ranked,
-        by_owner(ranked), sample_pass,
+        by_owner(ranked), sample_pass, by_name,
         {"derivatives": round(t1 - t0, 4), "samples": round(t2 - t1, 4),
          "analysis": round(t3 - t2, 4), "total": round(t3 - t0, 4)})
