@@ -20,7 +20,6 @@ from mechc.cells.sources import library_for_design
 from mechc.cli.common import check_output, options_from_args
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 from mechc.frontends import load_spec
-from mechc.ir.spec import Spec
 from mechc.tolerance.montecarlo import ToleranceSettings, run
 from mechc.tolerance.process import PROCESSES, process
 from mechc.tolerance.report import summary, to_json
@@ -139,7 +138,7 @@ def robust_options(c: argparse.ArgumentParser) -> None:
     """``mechc compile``'s options for robust design (this module keeps them with the
     tolerance command's)."""
     g = c.add_argument_group(
-        "robust design (combinational specs)",
+        "robust design",
         "with --tol or --process, compile, measure the yield by a tolerance run and change "
         "spring margins, over-travel stops and the stroke until it reaches --yield; the rounds "
         "and what changed are printed (exit 1 if the yield is not reached)")
@@ -172,9 +171,6 @@ def robust_design(args: argparse.Namespace):
                           samples=args.tol_samples, yield_level=args.yield_level)
     s.check()
     spec = load_spec(args.spec)
-    if not isinstance(spec, Spec):
-        raise UsageError(f"{args.spec}: --tol designs combinational specs; a sequential "
-                         "design's tolerance run is not built yet")
     opts = options_from_args(args)
     lib = load_library(opts.cell_dirs)
     design, rounds, met = robust_compile(spec, opts, lib, s,

@@ -22,11 +22,20 @@ from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.tolerance.batch import Batch, CheckKey
 from mechc.tolerance.dimensions import Dim, dimensions
-from mechc.tolerance.sensitivity import Ranked, by_owner, jacobian, lost_motion, rank
+from mechc.tolerance.sensitivity import (
+    Jacobian,
+    Ranked,
+    by_owner,
+    jacobian,
+    lost_motion,
+    rank,
+)
+from mechc.tolerance.sequential import SequentialBatch
 from mechc.tolerance.states import proof_states
 from mechc.tolerance.structural import OutputError, structural_error
 
 Z95 = 1.959963984540054
+SEQUENTIAL_CHUNK = 256  # samples a sequential walk carries at once (x 21 points a step)
 
 
 @dataclass(frozen=True)
@@ -106,14 +115,14 @@ def draw(dims: list[Dim], s: ToleranceSettings, n: int | None = None) -> np.ndar
 
 
 def prepare(design: Design, lib: Library, s: ToleranceSettings):
-    """The batch solver of ``design`` with its pins' lost motion, and the derivatives."""
+    """The batch solver of ``design`` with its pins' lost motion, and the derivatives (a
+    sequential design: its walks' batch, no derivatives, no pin play)."""
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
-    if design.sequential is not None or not isinstance(design.spec, Spec):
-        raise UsageError("a tolerance run proves combinational designs (every input state and "
-                         "single-input change); this design is sequential")
-    states = proof_states(design.spec)
     dims = dimensions(design.mechanism)
+    if design.sequential is not None or not isinstance(design.spec, Spec):
+        return SequentialBatch(design, lib, dims, s.proof_tolerance), Jacobian(dims, {})
+    states = proof_states(design.spec)
     batch = Batch(design, lib, states, dims, s.proof_tolerance)
     jac = jacobian(batch, s.chunk_states)
     batch.lost = lost_motion(jac, s.clearance) if s.clearance > 0 else {}
@@ -131,7 +140,8 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     dims = batch.dims
     X = draw(dims, s) if deltas is None else deltas
     N = X.shape[0]
-    per = max(1, s.chunk_states // batch.states.size)
+    per = max(1, s.chunk_states // batch.states.size) if isinstance(batch, Batch) \
+        else SEQUENTIAL_CHUNK
     passes, margins = [], []
     fails: dict[str, list[tuple[int, np.ndarray]]] = {}
     fail_count: dict[CheckKey, int] = {}
@@ -179,7 +189,7 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     nominal_margin = {o: float((s.proof_tolerance - v[0]) * stroke)
                       for o, v in nominal.worst_dev.items()}
     structural = structural_error(batch, {o: np.concatenate(v) for o, v in rest_pos.items()},
-                                  nominal.rest_pos, s.yield_level)
+                                  nominal.rest_pos, s.yield_level) if rest_pos else []
     ranked = rank(jac, tolerances(dims, s), stroke, X, margin)
     t3 = time.perf_counter()
     return ToleranceResult(

@@ -52,14 +52,19 @@ def summary(r: ToleranceResult, name: str, top: int = 10) -> str:
     rows = [(e.output, f"{e.spread_mm[0]:+.3f} .. {e.spread_mm[1]:+.3f}",
              f"{e.extreme_mm[0]:+.3f} .. {e.extreme_mm[1]:+.3f}", f"{e.lost_mm:.3f}",
              f"{e.mid_margin_mm:.3f}", f"{e.stroke_mm:g}") for e in r.structural]
-    lines += ["", f"structural error at rest (mm; central {s.yield_level:.0%} and extremes; "
-              f"margin to mid-stroke kept by {s.yield_level:.0%} of samples):",
-              table(rows, ["output", "spread", "extremes", "lost motion", "mid margin",
-                           "stroke"])]
+    if rows:
+        lines += ["", f"structural error at rest (mm; central {s.yield_level:.0%} and extremes; "
+                  f"margin to mid-stroke kept by {s.yield_level:.0%} of samples):",
+                  table(rows, ["output", "spread", "extremes", "lost motion", "mid margin",
+                               "stroke"])]
+    else:
+        lines += ["", "a sequential design: no structural error, derivatives or pin play "
+                  "(its walks are proven per sample; dimensions ranked by regression only)"]
     rows = [(x.dim.name, x.dim.owner, x.dim.what, f"{x.position_mm:.4f}",
              f"{x.margin_coef:+.4f}") for x in r.ranked[:top]]
     lines += ["", "dimensions that matter most (output movement at tolerance, mm; regression "
-              "of the output margin, mm):",
+              "of the output margin over the samples, mm, given at least 5 samples a "
+              "dimension):",
               table(rows, ["dimension", "owner", "what", "moves output", "margin"])]
     rows = [(k, f"{v:.4f}") for k, v in list(r.per_owner.items())[:top]]
     lines += ["", "per cell (root-sum-square of its dimensions' effects, mm):",

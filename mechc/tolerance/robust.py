@@ -12,6 +12,8 @@ What each failing check asks for:
   proof's allowance, which is a fraction of the stroke while the tolerances are millimetres),
   in more than half the samples the target lets fail: a longer stroke, 25 % a round (every
   part scales with it);
+- *SET and RESET together* (a MEMORY binds: its two faces overlap by the tolerances): a
+  longer stroke too;
 - *transmission angle*, *distance from toggle*: angles do not change with scale, and link
   proportions are each cell's own design: reported, not cured.
 """
@@ -29,6 +31,7 @@ from mechc.ir.spec import Spec
 from mechc.pipeline import CompileOptions, compile_spec
 from mechc.tolerance.batch import DWELL, REST
 from mechc.tolerance.montecarlo import Failing, ToleranceResult, ToleranceSettings, run
+from mechc.tolerance.sequential import JAM as MEMORY_BINDS
 
 MAX_ROUNDS = 6
 MAX_OVERTRAVEL = 0.12
@@ -85,10 +88,14 @@ def robust_compile(spec: Spec, opts: CompileOptions, lib: Library, s: ToleranceS
         # outputs off where nothing binds: scattered beyond the allowance; a longer stroke
         # when that alone would spend half the yield the target leaves
         off = (r.fails.get(REST, none) | r.fails.get(DWELL, none)) & ~jammed
+        # a MEMORY whose SET and RESET faces overlap by the tolerances: the faces' errors
+        # shrink against a longer stroke
+        off |= r.fails.get(MEMORY_BINDS, none)
         if off.sum() > (1 - s.yield_level) * r.samples / 2 \
                 and stroke < mech.stroke * MAX_STROKE_FACTOR:
-            why.append(f"stroke {stroke:g} -> {stroke * 1.25:g} mm (outputs off in "
-                       f"{int(off.sum())} samples where nothing binds)")
+            why.append(f"stroke {stroke:g} -> {stroke * 1.25:g} mm (outputs off where "
+                       f"nothing binds, or a MEMORY's SET and RESET overlap, in "
+                       f"{int(off.sum())} samples)")
             stroke = round(stroke * 1.25, 3)
         if not why:  # nothing this loop can change (angles) or every limit reached
             return design, rounds, False

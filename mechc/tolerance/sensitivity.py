@@ -76,14 +76,14 @@ def rank(jac: Jacobian, tols: np.ndarray, stroke: float, deltas: np.ndarray | No
     """Dimensions by how far each alone moves an output at its tolerance (largest first); the
     regression of the samples' margin on their deltas alongside, where samples are given."""
     D = len(jac.dims)
-    pos = np.zeros(D)
+    pos = np.zeros(D)  # no derivatives (a sequential design): zero, ranked by regression
     for J in jac.d.values():
         pos = np.maximum(pos, np.abs(J).max(axis=1) * tols * stroke)
     coef = np.zeros(D)
     if deltas is not None and margin is not None and len(margin) > 2:
         ok = np.isfinite(margin)
-        if ok.sum() < 3:
-            ok[:] = False  # nothing to regress on: every sample unsolvable somewhere
+        if ok.sum() < max(3, 5 * D):
+            ok[:] = False  # too few samples for D coefficients: no regression (zeros)
         X = deltas[ok]
         used = np.flatnonzero(X.std(axis=0) > 0) if len(X) else np.array([], int)
         if len(used) and ok.sum() > len(used) + 1:
