@@ -28,10 +28,13 @@ from mechc.tolerance.chart import sensitivity_chart
 from mechc.tolerance.montecarlo import ToleranceSettings, run
 
 ROOT = Path(__file__).resolve().parent.parent
-#: every combinational example (a sequential design is not yet run: mechc tolerance says so)
+#: every example (and the full adder with threshold generators)
 EXAMPLES = [("sorter.bool", ()), ("full_adder.bool", ()),
             ("full_adder.bool", ("--map", "threshold")), ("comparator2.bool", ()),
-            ("majority.pla", ()), ("sevenseg.bool", ()), ("full_adder_net.blif", ())]
+            ("majority.pla", ()), ("sevenseg.bool", ()), ("full_adder_net.blif", ()),
+            ("fv157.bool", ()), ("speedctl.fsm", ()), ("speedctl_sr.fsm", ()),
+            ("toggle.fsm", ()), ("toggle.kiss2", ()), ("gated_latch.fsm", ()),
+            ("sequence_detector.fsm", ())]
 
 
 def compiled(spec: str, extra: tuple[str, ...], out: Path):
@@ -91,12 +94,19 @@ def markdown(samples: int, tol: float, clearance: float, spring_tol: float) -> N
             fail = (f"{f.key.name} at {f.key.where} ({f.count / r.samples:.1%})" if f
                     else "none")
             top = r.ranked[0]
+            if top.position_mm > 0:
+                what = f"`{top.dim.name}` ({top.dim.what}, {top.position_mm:.3f} mm)"
+            elif top.margin_coef != 0:
+                what = (f"`{top.dim.name}` ({top.dim.what}; by regression, "
+                        f"{top.margin_coef:+.3f} mm of margin)")
+            else:
+                what = (f"— (sequential: no derivatives, and {r.samples} samples are fewer "
+                        f"than 5 a dimension for a regression)")
             spread = max((max(abs(e.spread_mm[0]), abs(e.spread_mm[1])) for e in r.structural),
                          default=0.0)
             name = spec + (" " + " ".join(extra) if extra else "")
             print(f"| `{name}` | {len(r.dims)} | {r.yield_:.2%} | [{lo:.2%}, {hi:.2%}] | {fail} "
-                  f"| `{top.dim.name}` ({top.dim.what}, {top.position_mm:.3f} mm) | "
-                  f"±{spread:.3f} mm |")
+                  f"| {what} | " + (f"±{spread:.3f} mm |" if r.structural else "— |"))
 
 
 SCALE_EXAMPLES = ["sorter.bool", "full_adder.bool", "comparator2.bool", "majority.pla"]

@@ -20,6 +20,7 @@ from mechc.tolerance.batch import Batch
 from mechc.tolerance.dimensions import Dim
 
 H_MM = 1e-3  # finite-difference step: far above rounding (1e-12 mm), far below any tolerance
+MIN_SAMPLES_PER_DIM = 5  # fewer samples than this per dimension: no regression (it over-fits)
 
 
 @dataclass
@@ -82,7 +83,7 @@ def rank(jac: Jacobian, tols: np.ndarray, stroke: float, deltas: np.ndarray | No
     coef = np.zeros(D)
     if deltas is not None and margin is not None and len(margin) > 2:
         ok = np.isfinite(margin)
-        if ok.sum() < max(3, 5 * D):
+        if ok.sum() < max(3, MIN_SAMPLES_PER_DIM * D):
             ok[:] = False  # too few samples for D coefficients: no regression (zeros)
         X = deltas[ok]
         used = np.flatnonzero(X.std(axis=0) > 0) if len(X) else np.array([], int)
