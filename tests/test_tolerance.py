@@ -191,6 +191,7 @@ def test_robust_compile_meets_the_yield_it_reports(tmp_path, cli):
     assert r.ci[1] >= 0.99 and r.yield_ >= 0.985
 
 
+@pytest.mark.slow
 def test_sequential_samples_agree_with_their_walks_proven_one_by_one(tmp_path):
     """A sequential design (the toggle): the samples' walks proven together agree, sample by
     sample, with each perturbed design written as JSON and proven alone by the kinematic
