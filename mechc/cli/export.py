@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from mechc.backends.bom import bom_rows, write_bom
-from mechc.backends.design_json import write_atomic
+from mechc.backends.design_json import design_from_json, design_to_json, write_atomic
 from mechc.backends.fabrication import Fabrication, fabrication
 from mechc.backends.svg import render
 from mechc.cells.sources import library_for_design
@@ -105,6 +105,10 @@ def run(args: argparse.Namespace) -> int:
     out = args.output or default_output(args.design, fmt)
     check_output(out, f"{fmt} export", [("input", args.design)])
     design = load_design_or_spec(args.design, args)
+    if not args.design.lower().endswith(".json"):
+        # the parts as a design file holds them (rounded), so a spec exports exactly what
+        # its compiled design does
+        design = design_from_json(design_to_json(design), args.design)
     if design.mechanism is None:
         raise UsageError(f"{args.design}: this design has no mechanism geometry; recompile the "
                          "spec with this mechc")
