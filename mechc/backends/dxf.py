@@ -35,7 +35,7 @@ SHEETS = "sheets"
 #: Room between rows and columns of sheets in the drawing (titles sit in it), mm.
 SHEET_SPACING = 60.0
 #: Plane colours (AutoCAD colour index), so planes read apart on screen.
-COLOURS = (1, 5, 3, 6, 4, 2, 30, 140, 200, 8)
+COLOURS = (1, 5, 94, 6, 30, 150, 200, 12, 8, 3)
 
 
 @dataclass(frozen=True)

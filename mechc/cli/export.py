@@ -61,6 +61,9 @@ def register(sub) -> None:
     e.add_argument("--gap", type=finite_float, default=3.0, metavar="MM",
                    help="dxf: least distance between parts and from the sheet's edge "
                    "(default: %(default)s mm)")
+    e.add_argument("--preview", metavar="IMAGE",
+                   help="dxf: also draw the sheets to IMAGE (.png, .svg or .pdf), as the DXF "
+                   "reads (ezdxf's drawing add-on)")
     e.add_argument("--by-plane", action="store_true",
                    help="dxf: each plane's parts on sheets of their own (default: all planes "
                    "share sheets, as they are cut from one plate)")
@@ -104,6 +107,12 @@ def run(args: argparse.Namespace) -> int:
         raise UsageError(f"--gap must be between 0 and 100 mm, got {args.gap:g}")
     out = args.output or default_output(args.design, fmt)
     check_output(out, f"{fmt} export", [("input", args.design)])
+    if args.preview:
+        if fmt != "dxf":
+            raise UsageError("--preview draws cut sheets: it goes with --format dxf")
+        if Path(args.preview).suffix.lower() not in (".png", ".svg", ".pdf"):
+            raise UsageError(f"--preview {args.preview}: expected a .png, .svg or .pdf file")
+        check_output(args.preview, "preview", [("input", args.design), ("DXF output", out)])
     design = load_design_or_spec(args.design, args)
     if not args.design.lower().endswith(".json"):
         # the parts as a design file holds them (rounded), so a spec exports exactly what
@@ -124,6 +133,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"{args.design} -> {out}: {len(fab.pieces)} parts on {len(res.sheets)} "
               f"sheet{'s' * (len(res.sheets) != 1)} ({', '.join(sizes)}), "
               f"{len(fab.planes)} planes, {_holes(fab)} holes")
+        if args.preview:
+            from mechc.backends.dxf_preview import preview  # matplotlib loads only for this
+
+            write_atomic(args.preview, preview(res.text, Path(args.preview).suffix[1:].lower()))
+            print(f"  sheets drawn to {args.preview}")
         if res.oversize:
             print(f"mechc: note: {len(res.oversize)} part(s) larger than the {sheet[0]:g} x "
                   f"{sheet[1]:g} mm sheet, each on a sheet of its own: "
