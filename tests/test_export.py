@@ -432,4 +432,24 @@ def test_preview_draws_the_sheets(designs, tmp_path):
     assert out.exists()
     code, err = run_cli("export", str(designs["sorter.bool"]), "-o", str(tmp_path / "a.csv"),
                         "--preview", str(tmp_path / "a.png"))
-    assert code == 2 and "goes with --format dxf" in err
+    assert code == 2 and "goes with --format dxf, stl or gltf" in err
+    assert not (tmp_path / "a.csv").exists()
+
+
+def test_preview_draws_the_assembly(designs, tmp_path):
+    """The picture of the assembly: the plane colours are in it, and its proportions are
+    those of a long, flat layout seen at a slant."""
+    import matplotlib.image
+
+    from mechc.backends.mesh import COLOURS
+
+    export(tmp_path, designs["sorter.bool"], "asm.glb", "--preview", str(tmp_path / "a.png"))
+    img = (matplotlib.image.imread(tmp_path / "a.png")[..., :3] * 255).round()
+    h, w = img.shape[:2]
+    assert w / h > 2  # the sorter is 899 x 206 mm
+    planes = {k for _, k, _ in plates(load(designs["sorter.bool"]))}
+    for k in planes:  # each plane's colour shows somewhere (lit faces keep it exactly)
+        assert (np.abs(img - np.array(COLOURS[k])).sum(axis=2) < 30).any(), k
+    code, err = run_cli("export", str(designs["sorter.bool"]), "-o", str(tmp_path / "b.stl"),
+                        "--preview", str(tmp_path / "b.svg"))
+    assert code == 2 and "expected a .png file" in err

@@ -63,7 +63,8 @@ def register(sub) -> None:
                    "(default: %(default)s mm)")
     e.add_argument("--preview", metavar="IMAGE",
                    help="dxf: also draw the sheets to IMAGE (.png, .svg or .pdf), as the DXF "
-                   "reads (ezdxf's drawing add-on)")
+                   "reads (ezdxf's drawing add-on); stl, gltf: draw the assembly to IMAGE "
+                   "(.png), seen from above at a slant")
     e.add_argument("--by-plane", action="store_true",
                    help="dxf: each plane's parts on sheets of their own (default: all planes "
                    "share sheets, as they are cut from one plate)")
@@ -108,10 +109,13 @@ def run(args: argparse.Namespace) -> int:
     out = args.output or default_output(args.design, fmt)
     check_output(out, f"{fmt} export", [("input", args.design)])
     if args.preview:
-        if fmt != "dxf":
-            raise UsageError("--preview draws cut sheets: it goes with --format dxf")
-        if Path(args.preview).suffix.lower() not in (".png", ".svg", ".pdf"):
-            raise UsageError(f"--preview {args.preview}: expected a .png, .svg or .pdf file")
+        kinds = {"dxf": (".png", ".svg", ".pdf"), "stl": (".png",), "gltf": (".png",)}
+        if fmt not in kinds:
+            raise UsageError("--preview draws cut sheets or the assembly: it goes with "
+                             "--format dxf, stl or gltf")
+        if Path(args.preview).suffix.lower() not in kinds[fmt]:
+            raise UsageError(f"--preview {args.preview}: expected a "
+                             f"{' or '.join(kinds[fmt])} file for --format {fmt}")
         check_output(args.preview, "preview", [("input", args.design), ("DXF output", out)])
     design = load_design_or_spec(args.design, args)
     if not args.design.lower().endswith(".json"):
@@ -157,10 +161,15 @@ def run(args: argparse.Namespace) -> int:
         data = write_stl(asm) if fmt == "stl" else write_gltf(
             asm, binary=Path(out).suffix.lower() != ".gltf")
         write_atomic(out, data)
+        if args.preview:
+            from mechc.backends.mesh_preview import preview as draw_3d  # matplotlib: only here
+
+            write_atomic(args.preview, draw_3d(asm))
         lo, hi = asm.bounds
         print(f"{args.design} -> {out}: {len(asm.parts)} parts on {len(fab.planes)} planes, "
               f"{hi[0] - lo[0]:.0f} x {hi[1] - lo[1]:.0f} x {hi[2] - lo[2]:.0f} mm, "
-              f"{len(data) / 1024:.0f} KB (rod-joint links are on the sheets only)")
+              f"{len(data) / 1024:.0f} KB (rod-joint links are on the sheets only)"
+              + (f"; drawn to {args.preview}" if args.preview else ""))
     _warn_unholed(fab)
     return EXIT_OK
 
