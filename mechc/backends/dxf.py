@@ -12,7 +12,8 @@ header ($INSUNITS 4, $MEASUREMENT 1).
 
 Every outline carries, as XDATA of the application ``MECHC``, the part's name, plane and the
 placement that put it on the sheet (turn in degrees about the design's origin, then the
-move), so a reader can put any part back where the design has it.
+move), so a reader can put any part back where the design has it. Two runs on one design give
+identical files.
 """
 
 from __future__ import annotations
@@ -62,7 +63,18 @@ def write_dxf(fab: Fabrication, sheet: tuple[float, float] = (1000.0, 600.0),
               gap: float = 3.0, by_plane: bool = False) -> DxfResult:
     """The cut sheets of ``fab`` as DXF text (see the module docstring). All parts share the
     sheets (they are one plate stock), each on its plane's layer; ``by_plane``: each plane's
-    parts on sheets of their own, one row of sheets per plane."""
+    parts on sheets of their own, one row of sheets per plane. The same text on every run:
+    ezdxf's fixed metadata (no dates, no random GUIDs) while this document is made."""
+    was = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        return _write(fab, sheet, gap, by_plane)
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = was
+
+
+def _write(fab: Fabrication, sheet: tuple[float, float], gap: float,
+           by_plane: bool) -> DxfResult:
     doc = ezdxf.new("R2010", setup=True, units=units.MM)
     doc.header["$MEASUREMENT"] = 1  # metric
     doc.header["$LUNITS"] = 2  # decimal
@@ -104,9 +116,18 @@ def write_dxf(fab: Fabrication, sheet: tuple[float, float] = (1000.0, 600.0),
             _part(msp, piece, Placement(pl.sheet, pl.angle, pl.dx + ox, pl.dy + oy),
                   layer_name(piece.plane), len(infos) - len(nested.sizes) + pl.sheet)
         y -= row_h + SHEET_SPACING
+    return DxfResult(_text(doc), infos, oversize)
+
+
+def _text(doc) -> str:
+    """The document's DXF text. ezdxf registers some CLASS records in an order that follows
+    Python's string hashing, which changes between runs; sorted, the file does not (the order
+    of CLASS records means nothing to a reader)."""
+    doc.classes.add_required_classes(doc.dxfversion)  # what write adds (again: no-op)
+    doc.classes.classes = dict(sorted(doc.classes.classes.items()))
     out = io.StringIO()
     doc.write(out)
-    return DxfResult(out.getvalue(), infos, oversize)
+    return out.getvalue()
 
 
 def _sheet_frame(msp, origin, size, title: str) -> None:
