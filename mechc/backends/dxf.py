@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import ezdxf
 from ezdxf import units
 from ezdxf.enums import TextEntityAlignment
-from shapely.geometry import Point
+from shapely.geometry import LineString, Point
 
 from mechc.backends.fabrication import Fabrication, Hole, Piece
 from mechc.backends.nest import Placement, nest
@@ -149,7 +149,7 @@ def _part(msp, piece: Piece, pl: Placement, layer: str, sheet: int) -> None:
         msp.add_lwpolyline(list(ring.coords)[:-1], close=True, dxfattribs={"layer": layer})
     for h in piece.holes:
         _hole(msp, h, pl, layer)
-    _label(msp, piece.id, g, f"{layer} labels")
+    _label(msp, piece.id, pl.apply(piece.solid()), f"{layer} labels")
 
 
 def _placed_point(p, pl: Placement) -> tuple[float, float]:
@@ -173,11 +173,23 @@ def _hole(msp, h: Hole, pl: Placement, layer: str) -> None:
 
 
 def _label(msp, text: str, g, layer: str) -> None:
-    """The part's name inside it where it fits (text about 0.6 x its height wide per
-    character), never taller than 4 mm."""
+    """The part's name along the longest horizontal run through it (clear of its holes), at a
+    height that fits that run (text about 0.6 x its height wide per character) and the part,
+    never taller than 4 mm."""
     x0, y0, x1, y1 = g.bounds
-    height = min(4.0, 0.6 * (y1 - y0), 0.9 * (x1 - x0) / (0.6 * max(1, len(text))))
-    at = g.representative_point() if not g.centroid.within(g) else g.centroid
+    runs = []  # (length, middle x, y)
+    for k in range(1, 32):  # horizontal lines across the part
+        y = y0 + (y1 - y0) * k / 32
+        cut = g.intersection(LineString([(x0 - 1, y), (x1 + 1, y)]))
+        for seg in getattr(cut, "geoms", [cut]):
+            if seg.geom_type == "LineString" and not seg.is_empty:
+                (ax, _), (bx, _) = seg.coords[0], seg.coords[-1]
+                runs.append((abs(bx - ax), (ax + bx) / 2, y))
+    if not runs:
+        return
+    run, x, _ = max(runs)
+    band = sorted(r[2] for r in runs if r[0] > run - 0.5 and abs(r[1] - x) < 0.5)
+    y = (band[0] + band[-1]) / 2  # the middle of the band of longest runs
+    height = min(4.0, 0.6 * (y1 - y0), 0.9 * run / (0.6 * max(1, len(text))))
     msp.add_text(text, height=max(height, 0.5), dxfattribs={"layer": layer}).set_placement(
-        (at.x, at.y), align=TextEntityAlignment.MIDDLE_CENTER)
-
+        (x, y), align=TextEntityAlignment.MIDDLE_CENTER)

@@ -115,7 +115,8 @@ def body_pieces(body: Body) -> list[Piece]:
     out = []
     for plane in sorted(by_plane):
         joined = unary_union([p.buffer(0) for p in by_plane[plane]])
-        parts = sorted(getattr(joined, "geoms", [joined]), key=lambda g: g.bounds)
+        parts = sorted((g for g in getattr(joined, "geoms", [joined]) if g.area > 0),
+                       key=lambda g: g.bounds)  # a polygon of no area is nothing to cut
         for k, g in enumerate(parts):
             name = body.id + (f"@{plane}" if several else "") + (f"#{k + 1}" if len(parts) > 1
                                                                  else "")
