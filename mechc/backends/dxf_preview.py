@@ -7,13 +7,11 @@ from __future__ import annotations
 import io
 
 import ezdxf
-import matplotlib
-
-matplotlib.use("Agg")  # files only, never a window
-import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
-from ezdxf.addons.drawing import Frontend, RenderContext  # noqa: E402
-from ezdxf.addons.drawing.config import BackgroundPolicy, Configuration  # noqa: E402
-from ezdxf.addons.drawing.matplotlib import MatplotlibBackend  # noqa: E402
+from ezdxf.addons.drawing import Frontend, RenderContext
+from ezdxf.addons.drawing.config import BackgroundPolicy, Configuration
+from ezdxf.addons.drawing.matplotlib import MatplotlibBackend
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
 
 def preview(dxf_text: str, fmt: str = "png", width_in: float = 12.0, dpi: int = 120) -> bytes:
@@ -23,16 +21,14 @@ def preview(dxf_text: str, fmt: str = "png", width_in: float = 12.0, dpi: int = 
     msp = doc.modelspace()
     lo, hi = _extent(msp)
     aspect = (hi[1] - lo[1]) / max(hi[0] - lo[0], 1e-9)
-    fig = plt.figure(figsize=(width_in, max(2.0, width_in * aspect)))
-    try:
-        ax = fig.add_axes((0, 0, 1, 1))
-        config = Configuration(background_policy=BackgroundPolicy.WHITE)
-        Frontend(RenderContext(doc), MatplotlibBackend(ax), config=config).draw_layout(msp)
-        out = io.BytesIO()
-        fig.savefig(out, format=fmt, dpi=dpi, facecolor="white")
-        return out.getvalue()
-    finally:
-        plt.close(fig)
+    fig = Figure(figsize=(width_in, max(2.0, width_in * aspect)))  # no pyplot: no global state
+    FigureCanvasAgg(fig)
+    ax = fig.add_axes((0, 0, 1, 1))
+    config = Configuration(background_policy=BackgroundPolicy.WHITE)
+    Frontend(RenderContext(doc), MatplotlibBackend(ax), config=config).draw_layout(msp)
+    out = io.BytesIO()
+    fig.savefig(out, format=fmt, dpi=dpi, facecolor="white")
+    return out.getvalue()
 
 
 def _extent(msp) -> tuple[tuple[float, float], tuple[float, float]]:
