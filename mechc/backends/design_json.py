@@ -87,23 +87,24 @@ def check_writable(path: str | Path) -> None:
         raise UsageError(f"{p}: directory '{parent}' does not exist")
 
 
-def write_atomic(path: str | Path, text: str) -> None:
+def write_atomic(path: str | Path, text: str | bytes) -> None:
     """Write via a temporary file in the same directory and rename: a failure leaves any
-    existing file untouched."""
+    existing file untouched. ``text``: UTF-8 text, or bytes (a binary format) as they are."""
     p = Path(path)
     check_writable(p)
+    data = text.encode("utf-8") if isinstance(text, str) else text
     if p.exists() and not p.is_file():  # a device or pipe (/dev/stdout, /dev/null): no rename
         try:
-            with open(p, "w", encoding="utf-8") as f:
-                f.write(text)
+            with open(p, "wb") as f:
+                f.write(data)
         except OSError as e:
             raise UsageError(f"{p}: cannot write: {e.strerror or e}") from None
         return
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
             f.flush()
             os.fsync(f.fileno())
         if p.exists():
