@@ -9,7 +9,7 @@ import sys
 import traceback
 
 from mechc import __version__
-from mechc.cli import bench, cells, draw, new_cell, simulate, synth
+from mechc.cli import bench, cells, draw, new_cell, simulate, synth, view
 from mechc.cli import compile as compile_cmd
 from mechc.errors import (
     EXIT_INTERNAL,
@@ -25,6 +25,7 @@ mechanical cells (sliders, levers, springs) with their geometry, and a simulatio
   mechc compile sorter.bool -o sorter.json     spec -> mechanism JSON (netlist + geometry)
   mechc simulate sorter.json                   prove it (levels: logic, kinematic, dynamic)
   mechc draw sorter.json -o sorter.svg         look at it
+  mechc view sorter.json -o sorter.html        watch it move (a page for any browser)
   mechc cells                                  list the cell library
 
 Exit status: 0 success, 1 a proof or design check failed, 2 bad input, 3 internal error.
@@ -68,6 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
     cells.register(sub)
     new_cell.register(sub)
     draw.register(sub)
+    view.register(sub)
     synth.register(sub)
     bench.register(sub)
     return p
