@@ -178,6 +178,7 @@ def test_clicking_inputs_gives_every_output_the_spec_value_every_state(browser, 
     assert checked["bodies"] >= len(states) * len(bodies)
     if name == "sorter" and os.environ.get("MECHC_VIEWER_SHOT"):
         click_to(page, {"A": 0, "B": 1, "C": 1, "D": 0})
+        page.select_option("#speed", "0.1")  # the default, as a user first sees it
         page.screenshot(path=os.environ["MECHC_VIEWER_SHOT"])
     assert errors == []
     page.context.close()
@@ -250,3 +251,82 @@ def test_slider_play_planes_zoom_and_pan(browser, pages):
     assert vb2[0] > vb1[0] and vb2[2] == pytest.approx(vb1[2])
     assert errors == []
     page.context.close()
+
+
+def test_gif_shows_the_spec_output_in_every_state_of_the_tour(tmp_path, pages):
+    """The GIF, re-read with pillow: one long frame per input state of the Gray-code tour,
+    and the output body is drawn green ('on') exactly where the spec says Z = 1."""
+    from PIL import Image
+
+    from mechc.backends.gif import COLOURS, HOLD_MS
+    from mechc.cli.main import main
+
+    design, _ = pages["sorter"]
+    out = tmp_path / "sorter.gif"
+    assert main(["view", str(design), "--gif", str(out)]) == 0
+    assert not (tmp_path / "sorter.html").exists()  # only the GIF was asked for
+    assert out.stat().st_size < 1.5e6
+    spec = load_spec(EXAMPLES / "sorter.bool")
+    green = np.array([int(COLOURS["out_on"][0][k:k + 2], 16) for k in (1, 3, 5)])
+    im = Image.open(out)
+    holds = []
+    for k in range(im.n_frames):
+        im.seek(k)
+        if im.info["duration"] >= HOLD_MS:
+            rgb = np.asarray(im.convert("RGB"), dtype=float)
+            holds.append(int((np.linalg.norm(rgb - green, axis=2) < 30).sum()))
+    assert len(holds) == 16
+    seen = set()
+    for i, px in enumerate(holds):
+        g = i ^ (i >> 1)  # the tour's order: reflected Gray code from every input off
+        state = {n: (g >> (3 - j)) & 1 for j, n in enumerate(spec.inputs)}
+        want = spec_values(spec, state)["Z"]
+        if want is not None:
+            seen.add(want)
+            assert (px > 50) == (want == 1), (state, px)
+    assert seen == {0, 1}
+
+
+@pytest.mark.slow
+def test_dynamic_page_plays_the_pymunk_run_and_clicks_still_give_the_spec(browser, pages,
+                                                                           tmp_path):
+    from mechc.cli.main import main
+
+    design, _ = pages["sorter"]
+    html = tmp_path / "dyn.html"
+    assert main(["view", str(design), "--dynamic", "--cases", "0", "-o", str(html)]) == 0
+    spec = load_spec(EXAMPLES / "sorter.bool")
+    errors: list[str] = []
+    page = open_page(browser, html, errors)
+    data = page.evaluate("window.mechcView.data")
+    assert data["level"] == "dynamic" and data["proof"]["dynamic"]["passed"]
+    # the tour is the dynamic run: 15 Gray-code changes, each sampled every 2 ms
+    moves = [s for s in data["tour"] if not s["hold"]]
+    assert len(moves) == 15
+    assert all(len(data["cases"][s["case"]]["t"]) > 21 for s in moves)
+    page.select_option("#speed", "1")
+    page.click('button[data-input="D"]')  # the run's first change: played from the run
+    wait_idle(page)
+    assert "dynamic proof's run" in page.inner_text("#status")
+    n = len(spec.inputs)
+    for m in list(range(1 << n)) + [0]:
+        state = {k: (m >> (n - 1 - i)) & 1 for i, k in enumerate(spec.inputs)}
+        click_to(page, state)
+        want = spec_values(spec, state)["Z"]
+        if want is not None:
+            assert dom_outputs(page)["Z"] == want, state
+    assert errors == []
+    page.context.close()
+
+
+def test_bad_input_is_refused_with_exit_2_and_nothing_written(cli, tmp_path, pages):
+    design, _ = pages["sorter"]
+    before = design.read_bytes()
+    code, _, err = cli("view", design, "-o", design)  # would overwrite the design
+    assert code == 2 and "mechc: error" in err and design.read_bytes() == before
+    code, _, err = cli("view", design, "--gif", tmp_path / "x.png")
+    assert code == 2 and ".gif" in err and not (tmp_path / "x.png").exists()
+    code, _, err = cli("view", tmp_path / "missing.json", "-o", tmp_path / "m.html")
+    assert code == 2 and "missing.json" in err and not (tmp_path / "m.html").exists()
+    code, _, err = cli("view", design, "--fps", "0", "-o", tmp_path / "f.html")
+    assert code == 2 and "--fps" in err and not (tmp_path / "f.html").exists()

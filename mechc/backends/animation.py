@@ -98,17 +98,26 @@ class Animation:
             out.append(polys)
         return out
 
+    def point_at(self, poses: np.ndarray, body: str, p) -> tuple[float, float]:
+        """Where design point ``p`` of ``body`` stands at ``poses`` (its design place where
+        the body has no pose)."""
+        i = self._row()[body]
+        dx, dy, a = poses[i]
+        if not (math.isfinite(dx) and math.isfinite(dy) and math.isfinite(a)):
+            return float(p[0]), float(p[1])
+        rx, ry = self.bodies[i]["ref"]
+        px, py = p[0] - rx, p[1] - ry
+        return (math.cos(a) * px - math.sin(a) * py + rx + dx,
+                math.sin(a) * px + math.cos(a) * py + ry + dy)
+
+    def _row(self) -> dict[str, int]:
+        return {b["id"]: i for i, b in enumerate(self.bodies)}
+
     def signals(self, poses: np.ndarray, which: str = "outputs") -> dict[str, float]:
         """Each terminal's signal (0 off, 1 on) at ``poses`` (the rule of docs/trace.md)."""
-        row = {b["id"]: i for i, b in enumerate(self.bodies)}
         out = {}
         for name, t in self.terminals[which].items():
-            i = row[t["body"]]
-            dx, dy, a = poses[i]
-            rx, ry = self.bodies[i]["ref"]
-            px, py = t["point"][0] - rx, t["point"][1] - ry
-            x = math.cos(a) * px - math.sin(a) * py + rx + dx
-            y = math.sin(a) * px + math.cos(a) * py + ry + dy
+            x, y = self.point_at(poses, t["body"], t["point"])
             (ox, oy), (nx, ny) = t["off"], t["on"]
             d2 = (nx - ox) ** 2 + (ny - oy) ** 2
             out[name] = ((x - ox) * (nx - ox) + (y - oy) * (ny - oy)) / d2
@@ -223,6 +232,8 @@ def _gray_tour(anim: Animation, nodes: dict[tuple, int]) -> list[Segment]:
 def _trace_tour(cases: list[tuple]) -> list[Segment]:
     """The trace's cases in order, each change followed by a hold of its end."""
     segs = []
+    if cases and cases[0][3] != "rest":  # begin still, at the first change's start
+        segs.append(Segment(cases[0][0], True, cases[0][1], cases[0][1], hold=True))
     for ci, a, b, kind in cases:
         if kind != "rest":
             segs.append(Segment(ci, False, a, b))

@@ -13,6 +13,7 @@
     return e;
   };
   const txt = (e, s) => { e.textContent = s; return e; };
+  const plural = (k, w) => `${k} ${w}${k === 1 ? "" : "s"}`;
 
   // ---- page -----------------------------------------------------------------------------
   const header = el("header", {}, document.body);
@@ -20,7 +21,8 @@
   const pk = D.proof.kinematic || {};
   const pd = D.proof.dynamic;
   txt(el("div", { class: "sub" }, header),
-    `${D.kind} design, ${D.inputs.length} inputs, ${D.outputs.length} outputs, ` +
+    `${D.kind} design, ${plural(D.inputs.length, "input")}, ` +
+    `${plural(D.outputs.length, "output")}, ` +
     `${nB} bodies, stroke ${D.stroke} mm | poses: ` +
     (pd ? `dynamic proof (pymunk) ${pd.passed ? "passed" : "FAILED"}, ` +
       "the closed form where it did not go" :
@@ -68,6 +70,17 @@
   txt(el("span", { class: "name" }, gPl), "planes");
   const fitBtn = txt(el("button", { id: "fit", title: "zoom to fit (wheel: zoom, " +
     "drag: pan)" }, bar2), "fit");
+  const gLeg = el("div", { class: "group legend", id: "legend" }, bar2);
+  const present = new Set(D.bodies.map(b => b.cls));
+  for (const [cls, name] of [["in", "input slider"], ["L0", "cell slider"], ["L1", "bar"],
+    ["L2", "lever"], ["L3", "layer 3"], ["L4", "layer 4+"], ["net", "rod, fan-out bar"],
+    ["out", "output (green: on)"]]) {
+    if (!present.has(cls)) continue;
+    const k = el("span", { class: "key" }, gLeg);
+    const sw = el("svg", { width: 22, height: 12, class: cls }, k, true);
+    el("path", { d: "M1,2H21V10H1Z" }, sw, true);
+    k.appendChild(document.createTextNode(name));
+  }
   const status = el("div", { id: "status" }, document.body);
   const main = el("main", {}, document.body);
   const svg = el("svg", { id: "view" }, main, true);
@@ -191,8 +204,8 @@
       const e = rx + dx - (c * rx - sn * ry), f = ry + dy - (sn * rx + c * ry);
       g.setAttribute("transform", `matrix(${c},${sn},${-sn},${c},${e},${f})`);
     }
-    const atRest = s.hold || T >= s.t0 + s.dur - 1e-9;
-    const node = D.nodes[s.end];
+    const atRest = s.hold || T >= s.t0 + s.dur - 1e-9 || T <= s.t0 + 1e-9;
+    const cur = here().node, node = D.nodes[cur];
     for (const name of D.outputs) {
       const t = termEl[name].t, sig = signal(t, pose), on = sig > 0.5;
       const o = outBox[name];
@@ -229,7 +242,7 @@
       inLbl[name].textContent = `${name} = ${on ? 1 : 0}`;
       ins.push(`${name}=${on ? 1 : 0}`);
     }
-    const edges = D.edges[String(s.end)] || {};
+    const edges = D.edges[String(cur)] || {};
     for (const name of D.inputs) {
       const ok = name in edges;
       inButtons[name].disabled = !ok;
@@ -240,7 +253,7 @@
     clock.textContent = `t = ${T.toFixed(3)} / ${total.toFixed(3)} s`;
     const root = document.documentElement.dataset;
     root.inputs = ins.join(" ");
-    root.node = String(s.end);
+    root.node = String(cur);
     root.busy = playing ? "1" : "0";
     root.state = node.state === null ? "" : node.state;
     root.rest = atRest ? "1" : "0";
@@ -267,17 +280,20 @@
     playBtn.textContent = "▶ play";
     document.documentElement.dataset.busy = "0";
   }
-  function toggle(name) { // move to the state with `name` changed, animated
+  function here() { // the state now: at a move's start its start, else (snapped) its end
     const k = segAt(T), s = segs[k];
-    const e = (D.edges[String(s.end)] || {})[name];
+    if (!s.hold && T <= s.t0 + 1e-9) return { node: s.start, keep: k, time: s.t0 };
+    return { node: s.end, keep: k + 1, time: s.t0 + s.dur };
+  }
+  function toggle(name) { // move to the state with `name` changed, animated
+    const h = here();
+    const e = (D.edges[String(h.node)] || {})[name];
     if (!e) { status.textContent = `${name} cannot change from this state.`; return; }
     stop();
-    const keep = segs.slice(0, k + 1);
-    const from = s.t0 + s.dur;
-    setSegs(keep.concat([
-      { case: e.case, rev: e.reverse, start: s.end, end: e.to, hold: false },
+    setSegs(segs.slice(0, h.keep).concat([
+      { case: e.case, rev: e.reverse, start: h.node, end: e.to, hold: false },
       { case: e.case, rev: e.reverse, start: e.to, end: e.to, hold: true }]));
-    T = from;
+    T = h.time;
     const n = D.nodes[e.to];
     status.textContent = `${name} → ${n.inputs[name]}: ` +
       (e.level === "dynamic" ? "the dynamic proof's run of this change" :

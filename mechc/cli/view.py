@@ -47,7 +47,7 @@ written, for inspection); 2 bad input.""")
                    "(default: %(default)s)")
     v.add_argument("--gif", metavar="OUT.gif",
                    help="also render the tour as an animated GIF (matplotlib, no browser)")
-    v.add_argument("--gif-width", type=int, default=720, metavar="PX",
+    v.add_argument("--gif-width", type=int, default=900, metavar="PX",
                    help="width of the GIF in pixels (default: %(default)s)")
     v.add_argument("--fps", type=int, default=12,
                    help="GIF frames per second (default: %(default)s)")
