@@ -385,3 +385,44 @@ def test_natural_size_keeps_scale_and_small_drawings_are_not_blown_up(sorter):
     assert float(nat.get("width")) == float(nat.get("viewBox").split()[2])
     small = ET.fromstring(draw_svg(sorter, {}, 0.5))
     assert float(small.get("width")) == float(small.get("viewBox").split()[2]) < 1600
+
+
+@pytest.mark.parametrize("which", ["sorter", "big"])
+def test_drawing_as_chromium_shows_it(which, request, browser, tmp_path):
+    """The SVG opened in a real browser at its own size (what a person sees at 100 % zoom):
+    the input and output labels render at least 16 px tall and the cell names 10 px, no text
+    is cut off by the picture's edge, the io labels do not overlap one another, and the parts
+    lie between the input column and the output column."""
+    design = request.getfixturevalue(which)
+    path = tmp_path / "d.svg"
+    path.write_text(draw_svg(design, {}))
+    root = ET.fromstring(path.read_text())
+    w, h = float(root.get("width")), float(root.get("height"))
+    page = browser.new_page(viewport={"width": int(w) + 1, "height": int(h) + 1})
+    page.goto(path.resolve().as_uri())
+    got = page.evaluate("""() => {
+        const r = e => { const b = e.getBoundingClientRect();
+                         return [b.left, b.top, b.right, b.bottom]; };
+        const texts = [...document.querySelectorAll('text')]
+            .filter(t => !t.classList.contains('halo'))
+            .map(t => [t.getAttribute('class') || '', t.textContent, ...r(t)]);
+        const bodies = [...document.querySelectorAll('g[data-body]')].map(r);
+        return {texts, bodies};
+    }""")
+    page.close()
+    texts, bodies = got["texts"], got["bodies"]
+    for _cls, text, x0, y0, x1, y1 in texts:
+        assert -0.5 <= x0 and x1 <= w + 0.5 and -0.5 <= y0 and y1 <= h + 0.5, (text, x0, x1)
+    io = [t for t in texts if "iol" in t[0] or "ior" in t[0]]
+    cells = [t for t in texts if t[0] == "lc"]
+    assert len(io) == len(design.netlist.inputs) + len(design.mechanism.outputs)
+    assert len(cells) == len(design.netlist.cells)
+    assert min(t[5] - t[3] for t in io) >= 16
+    assert min(t[5] - t[3] for t in cells) >= 10
+    for i, a in enumerate(io):
+        for b in io[i + 1:]:
+            assert a[4] <= b[2] or b[4] <= a[2] or a[5] <= b[3] or b[5] <= a[3], (a[1], b[1])
+    left = min(b[0] for b in bodies)
+    right = max(b[2] for b in bodies)
+    assert max(t[4] for t in io if "iol" in t[0]) < left
+    assert min(t[2] for t in io if "ior" in t[0]) > right

@@ -128,8 +128,8 @@ def test_page_is_one_file_that_loads_with_no_error_and_fetches_nothing(browser, 
     assert len(page.query_selector_all("g.body")) == len(
         page.query_selector_all("#bodies > g"))
     page.click('button[data-input="C"]')
-    page.wait_for_timeout(800)  # 0.12 s simulated at 1/10 speed: done
-    assert dom_inputs(page)["C"] == 1
+    page.wait_for_selector('html[data-busy="0"][data-inputs="A=0 B=0 C=1 D=0"]',
+                           state="attached", timeout=20_000)
     assert errors == []
     page.context.close()
 

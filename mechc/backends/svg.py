@@ -495,7 +495,7 @@ def _layout(design, mover: _Mover, boxes, conn, edge: list[_EdgeLabel], labels: 
     # the io columns: baselines on their rows, spread where rows are closer than a line
     for side in ("left", "right"):
         mine = [e for e in edge if e.side == side]
-        ys = _stack([top + (Y1 - e.row) * scale + 0.35 * fs_io for e in mine], 1.15 * fs_io)
+        ys = _stack([top + (Y1 - e.row) * scale + 0.35 * fs_io for e in mine], 1.25 * fs_io)
         for e, y in zip(mine, ys):
             e.y = y
     above_io = max([0.0] + [top - (e.y - fs_io) for e in edge])
