@@ -141,21 +141,28 @@
 
   // ---- poses ------------------------------------------------------------------------------
   const cases = D.cases.map(c => ({ t: c.t, poses: c.poses }));
-  function poseOf(seg, tau) { // flat [dx, dy, a, ...] tau seconds into seg
-    const c = cases[seg.case];
-    const t = c.t, P = c.poses, n = t.length;
-    if (seg.hold) return P[seg.rev ? 0 : n - 1];
-    let s = seg.rev ? t[n - 1] - tau : t[0] + tau;
-    if (s <= t[0]) return P[0];
-    if (s >= t[n - 1]) return P[n - 1];
-    let lo = 0, hi = n - 1;
-    while (hi - lo > 1) { const m = (lo + hi) >> 1; if (t[m] <= s) lo = m; else hi = m; }
-    const w = (s - t[lo]) / Math.max(t[hi] - t[lo], 1e-12);
-    const a = P[lo], b = P[hi], out = new Array(a.length);
-    for (let k = 0; k < a.length; k++) {
-      out[k] = (a[k] === null || b[k] === null) ? null : a[k] * (1 - w) + b[k] * w;
+  // a case's poses: per body one [dx, dy, a] (it stays put) or one per sample
+  function mix(c, lo, hi, w) { // flat [dx, dy, a, ...] between samples lo and hi
+    const out = new Array(3 * nB);
+    for (let i = 0; i < nB; i++) {
+      const e = c.poses[i], many = Array.isArray(e[0]);
+      const a = many ? e[lo] : e, b = many ? e[hi] : e;
+      for (let j = 0; j < 3; j++) {
+        out[3 * i + j] = (a[j] === null || b[j] === null) ? null : a[j] * (1 - w) + b[j] * w;
+      }
     }
     return out;
+  }
+  function poseOf(seg, tau) { // flat [dx, dy, a, ...] tau seconds into seg
+    const c = cases[seg.case];
+    const t = c.t, n = t.length;
+    if (seg.hold) { const k = seg.rev ? 0 : n - 1; return mix(c, k, k, 0); }
+    let s = seg.rev ? t[n - 1] - tau : t[0] + tau;
+    if (s <= t[0]) return mix(c, 0, 0, 0);
+    if (s >= t[n - 1]) return mix(c, n - 1, n - 1, 0);
+    let lo = 0, hi = n - 1;
+    while (hi - lo > 1) { const m = (lo + hi) >> 1; if (t[m] <= s) lo = m; else hi = m; }
+    return mix(c, lo, hi, (s - t[lo]) / Math.max(t[hi] - t[lo], 1e-12));
   }
   function place(i, pose, p) { // world point of body i's design point p
     const dx = pose[3 * i], dy = pose[3 * i + 1], a = pose[3 * i + 2];

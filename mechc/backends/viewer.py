@@ -77,14 +77,23 @@ def _nums(a: np.ndarray, digits: int) -> list:
 
 
 def _poses(p: np.ndarray) -> list:
-    """Flat [dx, dy, angle, ...] per sample (null where the trace has no pose)."""
+    """Per body: one [dx, dy, angle] if the body stays put through the case (most bodies, in
+    a change of one input), else one per sample; null where the trace has no pose."""
+    p = np.array(p, dtype=float)
+    p[..., :2] = np.round(p[..., :2], 4)
+    p[..., 2] = np.round(p[..., 2], 6)
+    p += 0.0  # no negative zeros
+    still = np.all((p == p[:1]) | (np.isnan(p) & np.isnan(p[:1])), axis=(0, 2))
+    rows = np.where(np.isfinite(p), p, np.nan).transpose(1, 0, 2).tolist()  # body, sample
     out = []
-    for frame in p:
-        row = []
-        for dx, dy, a in frame:
-            row += [_num(dx, 4), _num(dy, 4), _num(a, 6)]
-        out.append(row)
+    for b, keep in enumerate(still):
+        col = rows[b]
+        out.append(_nulls(col[0]) if keep else [_nulls(v) for v in col])
     return out
+
+
+def _nulls(v: list) -> list:
+    return [None if x != x else x for x in v]
 
 
 def _num(v: float, digits: int) -> float | None:
