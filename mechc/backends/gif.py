@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 
 import matplotlib
@@ -58,8 +59,10 @@ def frames_of(anim: Animation, fps: int, slow: float) -> list[tuple[Segment, flo
 
 
 def write(anim: Animation, path: str | Path, width: int = 720, fps: int = 12,
-          slow: float = 10.0) -> tuple[int, int]:
-    """Render the tour to ``path`` (atomically); returns (frames, bytes)."""
+          slow: float = 10.0,
+          progress: Callable[[int, int], None] | None = None) -> tuple[int, int]:
+    """Render the tour to ``path`` (atomically); returns (frames, bytes). ``progress`` is
+    told (frames drawn, frames) as the frames are drawn."""
     if not anim.tour:
         raise UsageError("nothing to animate: the trace has no tour")
     pts = np.array([p for b in anim.bodies for poly in b["outline"] for p in poly])
@@ -98,7 +101,10 @@ def write(anim: Animation, path: str | Path, width: int = 720, fps: int = 12,
                      color="#252525")
     images, durations = [], []
     palette = None
-    for seg, tau, ms in frames_of(anim, max(1, fps), slow):
+    plan = frames_of(anim, max(1, fps), slow)
+    for seg, tau, ms in plan:
+        if progress is not None:
+            progress(len(images), len(plan))
         pose = anim.pose_at(seg, tau)
         world = anim.world(pose)
         outs = anim.signals(pose)

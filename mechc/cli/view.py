@@ -91,8 +91,17 @@ def run(args: argparse.Namespace) -> int:
     if args.gif:
         from mechc.backends import gif  # matplotlib: loaded only when a GIF is asked for
 
-        frames, size = gif.write(anim, args.gif, width=args.gif_width, fps=args.fps,
-                                 slow=args.slow)
+        bar = Progress(1, f"GIF of {Path(args.design).name}")
+
+        def drawn(done: int, total: int) -> None:
+            bar.total = total
+            bar.update(done, "frames")
+
+        try:
+            frames, size = gif.write(anim, args.gif, width=args.gif_width, fps=args.fps,
+                                     slow=args.slow, progress=drawn)
+        finally:
+            bar.close()
         print(f"{args.design} -> {args.gif}: {frames} frames, {size / 1024:.0f} KB")
     if not passed:
         print("mechc: error: the proof the animation comes from failed (see mechc simulate)",
