@@ -222,10 +222,10 @@ def test_slider_play_planes_zoom_and_pan(browser, pages):
     assert 0.3 < sig < 0.7
     # play moves time on, pause stops it
     page.click("#play")
-    page.wait_for_timeout(400)
+    page.wait_for_function(f"() => window.mechcView.time() > {t_half} + 0.01")
     page.click("#play")
     t1 = page.evaluate("window.mechcView.time()")
-    assert t1 > t_half
+    assert t1 > t_half and not page.evaluate("window.mechcView.playing()")
     page.wait_for_timeout(200)
     assert page.evaluate("window.mechcView.time()") == t1
     # a plane hidden: its paths are not displayed, the others are
