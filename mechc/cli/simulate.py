@@ -61,7 +61,8 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.add_argument("--jobs", type=int, default=None, metavar="N",
                    help="dynamic: run the input changes (a sequential design: its walks) on N "
                    "processes; the report is the same as with --jobs 1, case by case (default: "
-                   f"every core this process may use, here {available_cores()})")
+                   f"every core this process may use, here {available_cores()}; a --trace "
+                   "run stays in this process)")
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="dynamic: run the same cases on the Dask distributed cluster whose "
                    "scheduler is at ADDRESS (e.g. tcp://127.0.0.1:8786; needs "

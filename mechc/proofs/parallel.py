@@ -136,12 +136,15 @@ def _on_pool(jobs: int, blob: bytes, cases: list, weights: list[int],
 
 # ---- a Dask cluster ---------------------------------------------------------------------------
 _CLUSTER_WORK: dict[str, tuple[CaseFn, Any, Library]] = {}
+CLUSTER_KEEP = 4  # proofs' work a cluster worker keeps unpacked
 
 
 def _cluster_case(blob: bytes, key: str, case: Any) -> Any:
     """A case on a cluster worker: the work is unpacked once per worker process (by key)."""
     if key not in _CLUSTER_WORK:
         work: Work = pickle.loads(blob)
+        while len(_CLUSTER_WORK) >= CLUSTER_KEEP:  # a long-lived worker: the newest proofs
+            del _CLUSTER_WORK[next(iter(_CLUSTER_WORK))]
         _CLUSTER_WORK[key] = (work.fn, work.shared, work.library())
     fn, shared, lib = _CLUSTER_WORK[key]
     return fn(shared, lib, case)
