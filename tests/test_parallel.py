@@ -137,3 +137,27 @@ def test_default_jobs_are_the_cores_this_process_may_use():
         assert parallel.available_cores() == len(os.sched_getaffinity(0))
     else:
         assert parallel.available_cores() == (os.cpu_count() or 1)
+
+
+def test_user_cells_are_loaded_from_their_files_in_each_worker(tmp_path, monkeypatch):
+    """A spawned worker shares nothing with this process: it loads the design's user cell
+    from its file, and its changes give the serial figures."""
+    from mechc.cells.library import load_library as load
+    from mechc.frontends.blif import parse_blif_file
+    from tests.test_user_cells import MAJ_BLIF, maj_dir
+
+    cells = maj_dir(tmp_path)
+    lib = load([str(cells)])
+    assert not lib["maj3"].standard
+    blif = tmp_path / "maj.blif"
+    blif.write_text(MAJ_BLIF)
+    design = compile_spec(parse_blif_file(str(blif)), library=lib)
+    assert [c.cell for c in design.netlist.cells.values()] == ["maj3"]
+    assert parallel.cell_files(lib) == (str(cells / "maj3.py"),)
+    monkeypatch.setattr(parallel, "_pool_context", lambda: multiprocessing.get_context("spawn"))
+    serial: list = []
+    one = prove_dynamic(design, design.spec, lib, extra=0, max_cases=4, record=serial)
+    spawned: list = []
+    two = prove_dynamic(design, design.spec, lib, extra=0, max_cases=4, record=spawned, jobs=2)
+    assert len(serial) == 4 and spawned == serial
+    assert _timeless(two) == _timeless(one)
