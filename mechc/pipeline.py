@@ -216,6 +216,7 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
         "cells_by_type": nl.count_by_type(),
         "parts": parts,
         "terms": eq.terms,
+        "products": eq.products,
         "literals": eq.literals,
         "shared_terms": eq.shared_terms,
         "depth": max(nl.depth().values(), default=0),
@@ -224,5 +225,6 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
                          "verified": "exhaustive" if all(c.method != "espresso" for c in
                                                          eq.covers.values())
                          else "exact on cubes",
+                         "time_limited": list(eq.time_limited),
                          "outputs": per_output},
     }

@@ -63,8 +63,12 @@ def uncovered_pairs(cubes: list[Cube], table: np.ndarray, n: int):
 
 
 def hazard_free(cubes: list[Cube], table: np.ndarray, n: int, masks: np.ndarray,
-                values: np.ndarray, time_limit: float = 5.0) -> list[Cube]:
-    """The cover plus the fewest (then smallest) candidate cubes that close every hazard."""
+                values: np.ndarray, time_limit: float = 5.0,
+                timed_out: list[str] | None = None) -> list[Cube]:
+    """The cover plus the fewest (then smallest) candidate cubes that close every hazard.
+
+    When the program's time limit runs out its best answer (or a greedy one) is used and
+    "hazard-free cover" is appended to ``timed_out``."""
     missing = uncovered_pairs(cubes, table, n)
     if not missing:
         return list(cubes)
@@ -84,6 +88,8 @@ def hazard_free(cubes: list[Cube], table: np.ndarray, n: int, masks: np.ndarray,
         chosen = np.flatnonzero(res.x > 0.5)
     else:
         chosen = _greedy(A, c)
+    if res.status != 0 and timed_out is not None:
+        timed_out.append("hazard-free cover")
     have = set(cubes)
     added = [Cube(int(masks[i]), int(values[i])) for i in chosen]
     return list(cubes) + [a for a in added if a not in have]
@@ -107,12 +113,20 @@ def _expand_pairs(missing, table: np.ndarray, n: int):
     full = (1 << n) - 1
     ms, vs = [], []
     for low, bit in missing:
-        for m in low.tolist():
-            # a prime found for an earlier pair often holds this one too (a wide function has
-            # thousands of missing pairs and a few primes): expanding each again cost minutes
-            # and gigabytes of duplicate candidates
-            if any(not (mk & bit) and (m & mk) == v for mk, v in zip(ms, vs)):
+        # a prime found for an earlier pair often holds this one too (a wide function has
+        # thousands of missing pairs and a few primes): expanding each again cost minutes
+        # and gigabytes of duplicate candidates
+        left = np.ones(len(low), dtype=bool)
+        if ms:
+            am, av = np.array(ms, dtype=np.int64), np.array(vs, dtype=np.int64)
+            ok = (am & bit) == 0
+            am, av = am[ok], av[ok]
+            for a in range(0, len(am), 256):
+                left &= ~((low[:, None] & am[None, a:a + 256]) == av[None, a:a + 256]).any(1)
+        for j in np.flatnonzero(left).tolist():
+            if not left[j]:
                 continue
+            m = int(low[j])
             mask, value = full & ~bit, m & ~bit
             for k in range(n):
                 b = 1 << (n - 1 - k)
@@ -123,6 +137,7 @@ def _expand_pairs(missing, table: np.ndarray, n: int):
                     mask, value = m2, value & m2
             ms.append(mask)
             vs.append(value)
+            left &= (low & mask) != value
     return np.array(ms, dtype=np.int64), np.array(vs, dtype=np.int64)
 
 
