@@ -66,6 +66,8 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
                                    layout)
     stats = design_stats(eq, nl, lib, layout)
     stats.update(interconnect_stats(mech))
+    if getattr(spec, "display", None):
+        stats["names"] = dict(spec.display)  # safe identifier -> the spec file's own name
     if amps:
         stats["amplified"] = amps
     design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,

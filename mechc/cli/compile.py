@@ -63,6 +63,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"{args.spec} -> {out}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
           f"{st['parts']} parts, {st['literals']} literals, {how}, "
           f"{time.perf_counter() - t0:.2f} s")
+    if st.get("names"):
+        print("  names: " + ", ".join(f"{v} as {k}" for k, v in st["names"].items()))
     if st["minimisation"].get("time_limited"):
         print(f"  time limit ran out (best answer found used): "
               f"{', '.join(st['minimisation']['time_limited'])}")

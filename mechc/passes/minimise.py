@@ -37,7 +37,7 @@ class MinimiseOptions:
     alt_time_limit: float = 3.0  # seconds per program for those alternatives (never reported)
     hazard_free: bool = True  # also derive covers with consensus terms (see logic/hazards.py)
     multi_output: bool = True  # one set of products for all outputs (fewest distinct products)
-    multi_time_limit: float = 6.0  # seconds for the multi-output step (at most time_limit)
+    multi_time_limit: float = 5.0  # seconds for the multi-output step (at most time_limit)
     hazard_time_limit: float = 2.0  # seconds per output for the consensus terms (ditto)
 
 
@@ -53,10 +53,10 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     limited: list[str] = []
     multi = opts.multi_output and len(spec.outputs) > 1 and spec.kind != "fsm"
     # with several outputs the per-output covers only start the multi-output step
-    popts = replace(opts, time_limit=min(opts.time_limit, 2.0)) if multi else opts
+    m = len(spec.outputs)
+    popts = replace(opts, time_limit=min(opts.time_limit, START_BUDGET / m)) if multi else opts
     # the mapper's alternatives share one budget, so many outputs do not multiply it
-    aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit,
-                                             ALT_BUDGET / len(spec.outputs)))
+    aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
     for name in spec.outputs:
         table = spec.table(name)
         covers[name], prime_sets[name] = _minimise_table(table, n, popts)
@@ -72,13 +72,14 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
             xf = _xor_form(spec.table(name), spec.inputs, aopts)
             if xf is not None:
                 eq.xor_forms[name] = xf
-    if opts.share and len(spec.outputs) > 1:
+    if opts.share and len(spec.outputs) > 1 and not multi:  # the multi-output step shares
         _share(spec, eq, prime_sets, opts)
     if multi:
         limited.extend(_multi_output(spec, eq, opts))
     eq.shared_terms = count_shared(eq)
     if opts.hazard_free:
-        hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit))
+        hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit,
+                                             max(HAZARD_BUDGET / m, 0.2)))
         for name in spec.outputs:
             table = spec.table(name)
             eq.hazard_free[name] = _with_consensus(eq.covers[name], table, n, prime_sets[name],
@@ -163,7 +164,12 @@ def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts,
 ALT_EXACT_MAX_INPUTS = 8
 #: Seconds the mapper's alternative forms of all outputs may take together (per output at most
 #: ``alt_time_limit``): 14 outputs at 3 s each made table3's minimisation take 19 s.
-ALT_BUDGET = 6.0
+ALT_BUDGET = 2.0
+#: Seconds the per-output covers that start the multi-output step take together.
+START_BUDGET = 1.5
+#: Seconds the consensus-term programs of all outputs take together (per output at most
+#: ``hazard_time_limit``).
+HAZARD_BUDGET = 2.0
 
 
 def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
