@@ -219,5 +219,6 @@ def _check_on_off(path, n, funcs, terms, outputs, display) -> None:
                     if any(d.contains(meet) for d in f.dc):
                         continue
                 raise SpecError(path, lineno, cols[j],
-                                f"output '{display.get(name, name)}': this on-set term meets the off-set term of "
-                                f"line {lineno2} (at input {meet.to_string(n)})")
+                                f"output '{display.get(name, name)}': this on-set term meets "
+                                f"the off-set term of line {lineno2} "
+                                f"(at input {meet.to_string(n)})")
