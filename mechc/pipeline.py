@@ -61,6 +61,8 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
         return compile_sequential(spec, opts, lib, stage=stage, seconds=seconds)
     eq = stage("minimise", minimise, spec, opts.minimise)
     mapped = stage("map", map_equations, eq, lib, opts.map)
+    if getattr(mapped, "equations", None) is not None:
+        eq = mapped.equations  # the mapper built the alternative covers (fewer parts)
     layout = stage("place", place, mapped.netlist)
     nl, layout, mech, amps = stage("assemble", assemble_powered, mapped.netlist, lib, opts,
                                    layout)

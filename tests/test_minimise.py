@@ -191,3 +191,28 @@ def test_wide_complement_is_cubes_not_minterms():
         for c in cover.cubes:
             got |= (pts & c.mask) == c.value
         assert np.array_equal(got, want)
+
+
+def test_mapper_builds_whichever_covers_cost_fewer_parts():
+    """Multi-output covers travel with the per-output ones as an alternative; the mapper keeps
+    the design with fewer parts (each mapped alone here as the reference) and says which
+    equations it built."""
+    from dataclasses import replace
+
+    from mechc.cells.library import load_library
+    from mechc.frontends.pla import parse_pla_file
+    from mechc.passes.map import map_equations
+
+    lib = load_library()
+
+    def parts(m):
+        return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values())
+
+    spec = parse_pla_file("tests/logic/pla/square5.pla")
+    eq = minimise(spec)
+    assert eq.alternative is not None
+    alone = parts(map_equations(replace(eq, alternative=None), lib))
+    other = parts(map_equations(eq.alternative, lib))
+    got = map_equations(eq, lib)
+    assert parts(got) == min(alone, other)
+    assert (got.equations is eq.alternative) == (other < alone)

@@ -263,7 +263,8 @@ def share_covers(cands: list[tuple[np.ndarray, np.ndarray]], on_rows: list[np.nd
 
 def solve_cover(A: sparse.csr_matrix, lits: np.ndarray, n: int,
                 time_limit: float) -> tuple[np.ndarray, bool]:
-    """Fewest columns covering every row of ``A``, then fewest literals with that count.
+    """Fewest columns covering every row of ``A``, then the least total ``lits`` (a cost per
+    column: literals, or parts) with that count.
 
     Returns (chosen column indices, proven). When the time limit runs out the better of the
     solver's incumbent and the greedy cover is returned, unproven."""

@@ -10,7 +10,8 @@ Two engines, both on truth tables (n <= MAX_TABLE_INPUTS):
 * exact: the multi-output primes — maximal pairs (cube c, output set S) with c inside every
   region of S (``multi_primes``, Shannon recursion with output sets as bit masks) — then a
   unate covering program with a row per (output, on-minterm) and a column per prime: fewest
-  columns, then fewest literals (``cover.solve_cover``, HiGHS with a time limit);
+  columns, then the fewest parts the mapper spends on them (``product_parts``; HiGHS with a
+  time limit, ``cover.solve_cover``);
 * heuristic: espresso's loop (``espresso.espresso``) on the characteristic function, each
   output a one-hot variable: a cube (c, S) is c · Π_{j∉S} ȳ_j, the points (x, e_i) carry output
   i's value and every point whose y is not one-hot is a don't-care. Its cover's products are
@@ -177,6 +178,23 @@ def max_outputs(cubes: list[Cube], sets: np.ndarray, n: int) -> np.ndarray:
 
 
 # ---- the covering program -------------------------------------------------------------------
+def product_parts(mask: int, value: int) -> int:
+    """Parts the mapper spends on a product (standard bar cells): none for a lone literal
+    (a wire, or an OR-NOT input), an AND bar of 2 + p parts for p plain literals, and an
+    inverting lever stage (an AND-NOT cell, 6 parts) per complemented literal."""
+    lits = mask.bit_count()
+    if lits <= 1:
+        return 0
+    neg = (mask & ~value).bit_count()
+    pos = lits - neg
+    return (2 + pos if pos >= 2 else 0) + 6 * neg
+
+
+def _weights(masks: np.ndarray, values: np.ndarray) -> np.ndarray:
+    return np.array([product_parts(int(a), int(b)) for a, b in zip(masks, values)],
+                    dtype=np.int64)
+
+
 def _rows_matrix(masks, values, outs, on: np.ndarray) -> sparse.csr_matrix:
     """Rows (output i, on-minterm r) x columns (candidate cubes allowed for output i)."""
     blocks = []
@@ -194,7 +212,7 @@ def _pick_uses(cubes: list[Cube], outs: np.ndarray, on: np.ndarray, n: int,
     """Per output the fewest (then smallest) chosen products covering its on-set."""
     masks = np.array([c.mask for c in cubes], dtype=np.int64)
     values = np.array([c.value for c in cubes], dtype=np.int64)
-    lits = np.array([c.literals() for c in cubes], dtype=np.int64)
+    lits = _weights(masks, values)
     use, complete = [], True
     for i in range(on.shape[0]):
         rows = np.flatnonzero(on[i]).astype(np.int64)
@@ -249,7 +267,7 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
         if pm is not None:
             A = _rows_matrix(pm, pv, ps, on)
             useful = np.asarray(A.sum(axis=0)).ravel() > 0
-            lits = np.array([int(x).bit_count() for x in pm], dtype=np.int64)
+            lits = _weights(pm, pv)
             chosen, proven = solve_cover(A[:, useful], lits[useful], n,
                                          0.6 * time_limit)
             idx = np.flatnonzero(useful)[chosen]
@@ -258,7 +276,7 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
                 return _finish(cubes, ps[idx], on, n, True, "exact", t0, deadline, limited)
             limited.append("exact multi-output cover")
     # heuristic: espresso on the one-hot characteristic function
-    starts = [start, *seeds]
+    starts = [*seeds, start]  # a PLA's own rows first: a better start than minimum covers
     share = 0.5 * (deadline - time.perf_counter()) / len(starts)
     cubes, cand = None, {}
     for k, s in enumerate(starts):
@@ -283,13 +301,13 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
     pv = np.array([c.value for c in pool], dtype=np.int64)
     A = _rows_matrix(pm, pv, outs, on)
     useful = np.asarray(A.sum(axis=0)).ravel() > 0
-    lits = np.array([c.literals() for c in pool], dtype=np.int64)
+    lits = _weights(pm, pv)
     remaining = deadline - time.perf_counter()
     if remaining > 0.2:
         chosen, proven = solve_cover(A[:, useful], lits[useful], n, 0.7 * remaining)
         idx = np.flatnonzero(useful)[chosen]
-        if len(idx) < len(cubes) or (len(idx) == len(cubes) and lits[idx].sum()
-                                     < sum(c.literals() for c in cubes)):
+        own = sum(product_parts(c.mask, c.value) for c in cubes)
+        if len(idx) < len(cubes) or (len(idx) == len(cubes) and lits[idx].sum() < own):
             cubes = [pool[k] for k in idx]
             method = "multi-output espresso+cover"
         if not proven:

@@ -52,14 +52,12 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     comp_sets = {}
     limited: list[str] = []
     multi = opts.multi_output and len(spec.outputs) > 1 and spec.kind != "fsm"
-    # with several outputs the per-output covers only start the multi-output step
     m = len(spec.outputs)
-    popts = replace(opts, time_limit=min(opts.time_limit, START_BUDGET / m)) if multi else opts
     # the mapper's alternatives share one budget, so many outputs do not multiply it
     aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
     for name in spec.outputs:
         table = spec.table(name)
-        covers[name], prime_sets[name] = _minimise_table(table, n, popts)
+        covers[name], prime_sets[name] = _minimise_table(table, n, opts)
         if not covers[name].proven and covers[name].method != "expand":
             limited.append(f"cover of {name}")
         if opts.complements:
@@ -75,20 +73,44 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     if opts.share and len(spec.outputs) > 1 and not multi:  # the multi-output step shares
         _share(spec, eq, prime_sets, opts)
     if multi:
+        per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
+                               eq.xor_forms)
         limited.extend(_multi_output(spec, eq, opts))
+        if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
+            _share(spec, per_output, prime_sets, replace(opts, time_limit=min(
+                opts.time_limit, opts.multi_time_limit)))
+            for o in eq.outputs:  # not the multi-output minimum, whatever each one is alone
+                c = per_output.covers[o]
+                per_output.covers[o] = Cover(c.cubes, False, "per-output", c.seconds)
+            eq.alternative = per_output
     eq.shared_terms = count_shared(eq)
     if opts.hazard_free:
         hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit,
                                              max(HAZARD_BUDGET / m, 0.2)))
+        # products built for some output: closing a hazard with one costs an OR input only
+        built = list(dict.fromkeys(c for o in spec.outputs for c in eq.covers[o].cubes)) \
+            if multi else []
         for name in spec.outputs:
             table = spec.table(name)
             eq.hazard_free[name] = _with_consensus(eq.covers[name], table, n, prime_sets[name],
-                                                   hopts, limited, name)
+                                                   hopts, limited, name, built)
             if name in comps:
                 eq.hazard_free_complements[name] = _with_consensus(
                     comps[name], _complement(table), n, comp_sets[name], _alt(hopts), limited,
                     f"complement of {name}")
+    alt = eq.alternative
+    if alt is not None:
+        alt.shared_terms = count_shared(alt)
+        alt.hazard_free_complements = eq.hazard_free_complements
+        if opts.hazard_free:
+            for name in spec.outputs:
+                alt.hazard_free[name] = _with_consensus(
+                    alt.covers[name], spec.table(name), n, prime_sets[name], hopts, limited,
+                    f"{name} (per-output covers)")
+        verify(spec, alt)
     eq.time_limited = limited
+    if alt is not None:
+        alt.time_limited = limited
     verify(spec, eq)
     return eq
 
@@ -122,7 +144,10 @@ def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
     return len(distinct), sum(c.literals() for c in distinct) + sum(len(x) for x in covers)
 
 
-def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
+def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions, deadline: bool = False):
+    """Exact cover of one output (primes, then the covering program). With ``deadline`` the
+    time limit also bounds the prime generation (a start for the multi-output step), past
+    which primes are grown from the on-minterms instead (method ``expand``)."""
     t0 = time.perf_counter()
     on = np.flatnonzero(table == 1).astype(np.int64)
     dc = np.flatnonzero(table == DC).astype(np.int64)
@@ -130,7 +155,8 @@ def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
         return Cover([], True, "exact", time.perf_counter() - t0), None
     region = table != 0
     try:
-        masks, values = prime_implicants(region, limit=opts.prime_limit)
+        masks, values = prime_implicants(region, limit=opts.prime_limit,
+                                         deadline=t0 + opts.time_limit if deadline else None)
         method_note = None
     except TooManyPrimes:
         masks, values = expand_primes(region, on, n)
@@ -146,12 +172,13 @@ def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
 
 
 def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts,
-                    limited: list[str] | None = None, label: str = "") -> Cover:
+                    limited: list[str] | None = None, label: str = "",
+                    shared: list[Cube] = ()) -> Cover:
     if primes is None:
         return cover
     masks, values, _on, _dc = primes
     timed: list[str] = []
-    cubes = hazard_free(cover.cubes, table, n, masks, values, opts.time_limit, timed)
+    cubes = hazard_free(cover.cubes, table, n, masks, values, opts.time_limit, timed, shared)
     if timed and limited is not None:
         limited.append(f"hazard-free cover of {label}")
     if len(cubes) == len(cover.cubes):
@@ -165,8 +192,6 @@ ALT_EXACT_MAX_INPUTS = 8
 #: Seconds the mapper's alternative forms of all outputs may take together (per output at most
 #: ``alt_time_limit``): 14 outputs at 3 s each made table3's minimisation take 19 s.
 ALT_BUDGET = 2.0
-#: Seconds the per-output covers that start the multi-output step take together.
-START_BUDGET = 1.5
 #: Seconds the consensus-term programs of all outputs take together (per output at most
 #: ``hazard_time_limit``).
 HAZARD_BUDGET = 2.0

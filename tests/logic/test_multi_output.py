@@ -170,7 +170,8 @@ def test_tiny_time_limit_is_reported():
 def test_hazard_step_time_limit_is_reported():
     """The consensus-term program given almost no time on a function with many hazards."""
     rng = np.random.default_rng(5)
-    n = 10
-    t = random_table(rng, n, p_on=0.5, p_dc=0.0)
-    eq = minimise(spec_of([t], n), MinimiseOptions(hazard_time_limit=0.001, complements=False))
+    n = 11
+    t = random_table(rng, n, p_on=0.6, p_dc=0.0)
+    eq = minimise(spec_of([t], n), MinimiseOptions(hazard_time_limit=0.001, complements=False,
+                                                   time_limit=2))
     assert any(s.startswith("hazard-free cover of") for s in eq.time_limited)
