@@ -95,7 +95,7 @@ def _mprimes(f: np.ndarray, n: int, k: int, memo, caps):
         if deadline is not None and time.perf_counter() > deadline:
             raise TooManyPrimes("time")
         if len(m0) and len(m1):
-            cm, cv, cs = _mconsensus(m0, v0, s0, m1, v1, s1, limit)
+            cm, cv, cs = _mconsensus(m0, v0, s0, m1, v1, s1, limit, deadline)
         else:
             cm = cv = cs = np.zeros(0, dtype=np.int64)
         keep0 = ~_mmember(m0, v0, s0, cm, cv, cs)
@@ -110,7 +110,8 @@ def _mprimes(f: np.ndarray, n: int, k: int, memo, caps):
     return res
 
 
-def _mconsensus(m0, v0, s0, m1, v1, s1, limit: int | None, budget: int = 4_000_000):
+def _mconsensus(m0, v0, s0, m1, v1, s1, limit: int | None, deadline: float | None,
+                budget: int = 4_000_000):
     """Maximal (cube, outputs) among the consistent intersections with a common output."""
     step = max(1, budget // max(1, len(m1)))
     parts = []
@@ -122,7 +123,7 @@ def _mconsensus(m0, v0, s0, m1, v1, s1, limit: int | None, budget: int = 4_000_0
     trip = np.unique(np.concatenate(parts), axis=0)
     if limit is not None and len(trip) > 4 * limit:  # the pairwise maximality step is quadratic
         raise TooManyPrimes(len(trip))
-    return _mmaximal(trip[:, 0].copy(), trip[:, 1].copy(), trip[:, 2].copy())
+    return _mmaximal(trip[:, 0].copy(), trip[:, 1].copy(), trip[:, 2].copy(), deadline)
 
 
 def _mmember(m, v, s, cm, cv, cs) -> np.ndarray:
@@ -136,13 +137,15 @@ def _mmember(m, v, s, cm, cv, cs) -> np.ndarray:
     return out
 
 
-def _mmaximal(m, v, s, block: int = 1024):
+def _mmaximal(m, v, s, deadline: float | None = None, block: int = 1024):
     """Drop every (cube, outputs) contained in another of the set."""
     if len(m) <= 1:
         return m, v, s
     lits = np.array([int(x).bit_count() for x in m])
     keep = np.ones(len(m), dtype=bool)
     for a in range(0, len(m), block):
+        if deadline is not None and time.perf_counter() > deadline:
+            raise TooManyPrimes("time")
         bm, bv, bs, bl = m[a:a + block], v[a:a + block], s[a:a + block], lits[a:a + block]
         cont = (((m[None, :] & ~bm[:, None]) == 0) & ((bv[:, None] & m[None, :]) == v[None, :])
                 & ((bs[:, None] & ~s[None, :]) == 0))
