@@ -56,6 +56,8 @@ def run(args: argparse.Namespace) -> int:
     methods = {v["method"] for v in st["minimisation"]["outputs"].values()}
     if st["minimisation"]["proven"]:
         how = "minimum proven"
+    elif "per-output" in methods:
+        how = "per-output minimum covers, shared (fewer parts than the multi-output cover)"
     elif "espresso" in methods:
         how = "heuristic cover (espresso-style, wide PLA): not proven minimal"
     else:
