@@ -61,11 +61,15 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
         return compile_sequential(spec, opts, lib, stage=stage, seconds=seconds)
     eq = stage("minimise", minimise, spec, opts.minimise)
     mapped = stage("map", map_equations, eq, lib, opts.map)
+    if getattr(mapped, "equations", None) is not None:
+        eq = mapped.equations  # the mapper built the alternative covers (fewer parts)
     layout = stage("place", place, mapped.netlist)
     nl, layout, mech, amps = stage("assemble", assemble_powered, mapped.netlist, lib, opts,
                                    layout)
     stats = design_stats(eq, nl, lib, layout)
     stats.update(interconnect_stats(mech))
+    if getattr(spec, "display", None):
+        stats["names"] = dict(spec.display)  # safe identifier -> the spec file's own name
     if amps:
         stats["amplified"] = amps
     design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
@@ -216,6 +220,7 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
         "cells_by_type": nl.count_by_type(),
         "parts": parts,
         "terms": eq.terms,
+        "products": eq.products,
         "literals": eq.literals,
         "shared_terms": eq.shared_terms,
         "depth": max(nl.depth().values(), default=0),
@@ -224,5 +229,6 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
                          "verified": "exhaustive" if all(c.method != "espresso" for c in
                                                          eq.covers.values())
                          else "exact on cubes",
+                         "time_limited": list(eq.time_limited),
                          "outputs": per_output},
     }

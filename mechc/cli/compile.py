@@ -56,6 +56,8 @@ def run(args: argparse.Namespace) -> int:
     methods = {v["method"] for v in st["minimisation"]["outputs"].values()}
     if st["minimisation"]["proven"]:
         how = "minimum proven"
+    elif "per-output" in methods:
+        how = "per-output minimum covers, shared (fewer parts than the multi-output cover)"
     elif "espresso" in methods:
         how = "heuristic cover (espresso-style, wide PLA): not proven minimal"
     else:
@@ -63,6 +65,11 @@ def run(args: argparse.Namespace) -> int:
     print(f"{args.spec} -> {out}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
           f"{st['parts']} parts, {st['literals']} literals, {how}, "
           f"{time.perf_counter() - t0:.2f} s")
+    if st.get("names"):
+        print("  names: " + ", ".join(f"{v} as {k}" for k, v in st["names"].items()))
+    if st["minimisation"].get("time_limited"):
+        print(f"  time limit ran out (best answer found used): "
+              f"{', '.join(st['minimisation']['time_limited'])}")
     for o in design.spec.outputs:
         print(f"  {o} = {design.equations[o]}")
         if design.implemented.get(o) and design.implemented[o] != design.equations[o]:
