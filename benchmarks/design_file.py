@@ -42,6 +42,7 @@ from mechc.backends.design_json import (
     check_design,
     check_numbers,
     check_references,
+    design_bytes,
     design_from_json,
     design_to_json,
     dumps_design,
@@ -95,8 +96,9 @@ def old_write(obj: dict, path: Path) -> None:
 
 def new_write(obj: dict, path: Path) -> None:
     text = dumps_design(obj)
-    check_design(json.loads(text), str(path))
-    path.write_text(text)
+    check_design(json.loads(text), str(path), text)
+    data = design_bytes(text, path)  # gzip-compressed for a .gz name
+    path.write_bytes(data if isinstance(data, bytes) else data.encode())
 
 
 def old_load(path: Path):
@@ -156,29 +158,32 @@ def main() -> None:
         design, t_compile = timed(compile_spec, load_spec(str(spec_path)), opts)
         obj = design_to_json(design)
         print(f"  {design.stats['cells']} cells, compiled in {t_compile:.1f} s")
-        old, new = tmp / "indented.json", tmp / "compact.json"
+        old, new, gz = tmp / "indented.json", tmp / "compact.json", tmp / "compact.json.gz"
         _, w_old = timed(old_write, obj, old)
         _, w_new = timed(new_write, obj, new)
-        s_old, s_new = old.stat().st_size, new.stat().st_size
+        _, w_gz = timed(new_write, obj, gz)
+        s_old, s_new, s_gz = old.stat().st_size, new.stat().st_size, gz.stat().st_size
         assert json.loads(old.read_bytes()) == json.loads(new.read_bytes())  # same content
         d_old, l_old = timed(old_load, old)
         _, l_new = timed(new_load, new)
         _, l_new_old = timed(new_load, old)
+        _, l_gz = timed(new_load, gz)
         lib = load_library()
         rep, t_proof = timed(prove, d_old, d_old.spec, lib, "logic")
         assert rep.passed, rep.summary_text()
         sim_old = cli_seconds("simulate", old, "--level", "logic")
         sim_new = cli_seconds("simulate", new, "--level", "logic")
+        sim_gz = cli_seconds("simulate", gz, "--level", "logic")
         rows = [
-            ("file size (MB)", s_old / 1e6, s_new / 1e6),
-            ("write: serialise + check + write (s)", w_old, w_new),
-            ("load: parse + check + Design (s)", l_old, l_new),
-            ("simulate --level logic, whole command (s)", l_old + t_proof, sim_new),
+            ("file size (MB)", s_old / 1e6, s_new / 1e6, s_gz / 1e6),
+            ("write: serialise + check + write (s)", w_old, w_new, w_gz),
+            ("load: parse + check + Design (s)", l_old, l_new, l_gz),
+            ("simulate --level logic, whole command (s)", l_old + t_proof, sim_new, sim_gz),
         ]
         print(f"\n| {a.inputs}-input random spec, {design.stats['cells']} cells | before | now "
-              "| before / now |\n|---|---:|---:|---:|")
-        for name, b, n in rows:
-            print(f"| {name} | {b:.2f} | {n:.2f} | {b / n:.1f}x |")
+              "| before / now | now, .json.gz |\n|---|---:|---:|---:|---:|")
+        for name, b, n, z in rows:
+            print(f"| {name} | {b:.2f} | {n:.2f} | {b / n:.1f}x | {z:.2f} |")
         print(f"\nCPU seconds. before = indented JSON, jsonschema; now = compact layout, "
               "jsonschema-rs. "
               f"The logic proof alone: {t_proof:.2f} s. 'simulate' before is its load plus the "

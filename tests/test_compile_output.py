@@ -5,6 +5,7 @@ compile, the proofs it runs before writing, and the flow-table rows merged."""
 from __future__ import annotations
 
 import copy
+import gzip
 import io
 import json
 import time
@@ -225,3 +226,23 @@ def test_merged_flow_table_rows_are_named(cli, tmp_path):
     code, stdout, err = cli("compile", EXAMPLES / "toggle.kiss2", "-o", tmp_path / "t.json")
     assert code == 0, err
     assert "flow table" not in stdout  # nothing merged, nothing said
+
+
+def test_a_gzip_design_is_the_same_text_and_reads_back(cli, tmp_path):
+    gz, plain = tmp_path / "s.json.gz", tmp_path / "s.json"
+    for out in (gz, plain):
+        code, _, err = cli("compile", EXAMPLES / "sorter.bool", "-o", out, "--quiet")
+        assert code == 0, err
+    assert gzip.decompress(gz.read_bytes()) == plain.read_bytes()  # read back by gzip itself
+    assert gz.stat().st_size < plain.stat().st_size / 3
+    code, _, _ = cli("compile", EXAMPLES / "sorter.bool", "-o", tmp_path / "t.json.gz", "-q")
+    assert (tmp_path / "t.json.gz").read_bytes() == gz.read_bytes()  # reproducible bytes
+    for level in ("logic", "kinematic"):
+        code, out, err = cli("simulate", gz, "--level", level)
+        assert code == 0 and "PASSED" in out, err
+    code, _, err = cli("draw", gz, "-o", tmp_path / "s.svg")
+    assert code == 0, err
+    broken = tmp_path / "broken.json.gz"
+    broken.write_bytes(gz.read_bytes()[:200])
+    code, _, err = cli("simulate", broken, "--level", "logic")
+    assert code == 2 and "broken.json.gz: cannot read design: a damaged gzip file" in err

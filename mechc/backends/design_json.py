@@ -7,16 +7,19 @@ whitespace. A 10-input random spec's design is about 2.6 times smaller that way 
 and still diffs line by line (benchmarks/design_file.py). Reading validates against the schema
 with jsonschema-rs, and only on a failure with the pure-Python jsonschema, whose error path and
 message the user sees: the same verdict and message as before, a hundred times faster on a
-large design. Any valid JSON layout loads, indented files of earlier versions included.
+large design. Any valid JSON layout loads, indented files of earlier versions included, and a
+design written as ``NAME.json.gz`` is the same text gzip-compressed (about 7 times smaller again).
 """
 
 from __future__ import annotations
 
+import gzip
 import json
 import math
 import os
 import re
 import tempfile
+import zlib
 from dataclasses import asdict, fields
 from functools import lru_cache
 from importlib import resources
@@ -82,6 +85,18 @@ def _net_key(name: str):
     return (0, 0, name)
 
 
+#: The first bytes of a gzip file: a design may be written compressed (``-o NAME.json.gz``).
+GZIP_MAGIC = b"\x1f\x8b"
+
+
+def design_bytes(text: str, path: str | Path) -> str | bytes:
+    """What a design file at ``path`` holds: the JSON text, or for a name ending in ``.gz``
+    that text gzip-compressed (with no time stamp, so the bytes stay reproducible)."""
+    if str(path).lower().endswith(".gz"):
+        return gzip.compress(text.encode("utf-8"), mtime=0)
+    return text
+
+
 def dumps(obj: dict) -> str:
     """Indented JSON: small documents a person reads (proof reports)."""
     return json.dumps(obj, indent=2, ensure_ascii=False) + "\n"
@@ -138,23 +153,24 @@ def check_writable(path: str | Path) -> None:
         raise UsageError(f"{p}: directory '{parent}' does not exist")
 
 
-def write_atomic(path: str | Path, text: str) -> None:
+def write_atomic(path: str | Path, text: str | bytes) -> None:
     """Write via a temporary file in the same directory and rename: a failure leaves any
-    existing file untouched."""
+    existing file untouched. ``text`` as str is written as UTF-8; bytes as they are."""
     p = Path(path)
     check_writable(p)
+    data = text.encode("utf-8") if isinstance(text, str) else text
     if p.exists() and not p.is_file():  # a device or pipe (/dev/stdout, /dev/null): no rename
         try:
-            with open(p, "w", encoding="utf-8") as f:
-                f.write(text)
+            with open(p, "wb") as f:
+                f.write(data)
         except OSError as e:
             raise UsageError(f"{p}: cannot write: {e.strerror or e}") from None
         return
     tmp = None
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent)
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
             f.flush()
             os.fsync(f.fileno())
         if p.exists():
@@ -218,6 +234,11 @@ DECODE_ERRORS = (KeyError, IndexError, TypeError, ValueError, AttributeError)
 def load_design_json(path: str | Path) -> dict:
     p = Path(path)
     data = read_input(p, "a design file (.json)", "design")
+    if data[:2] == GZIP_MAGIC:  # a design written as NAME.json.gz
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as e:
+            raise UsageError(f"{p}: cannot read design: a damaged gzip file ({e})") from None
     try:
         obj = json.loads(data)  # bytes: UTF-8, UTF-16 or UTF-32, as RFC 8259 allows
     except json.JSONDecodeError as e:

@@ -224,7 +224,7 @@ def by_type(d: dict) -> str:
 
 def load_design_or_spec(path: str, args: argparse.Namespace) -> Design:
     """A compiled design (.json), or a spec compiled in memory."""
-    if path.lower().endswith(".json"):  # the logic level reads no geometry
+    if path.lower().endswith((".json", ".json.gz")):  # the logic level reads no geometry
         return design_from_json(load_design_json(path), path,
                                 mechanism=getattr(args, "level", None) != "logic")
     # a logic proof of a sequential spec needs the netlist only, not the mechanism

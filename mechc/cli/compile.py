@@ -10,6 +10,7 @@ from pathlib import Path
 
 from mechc.backends.design_json import (
     check_design,
+    design_bytes,
     design_from_json,
     design_to_json,
     dumps_design,
@@ -37,11 +38,14 @@ def register(sub) -> None:
     c = sub.add_parser("compile", help="compile a spec to a netlist JSON",
                        description="Parse SPEC (" + ", ".join(SPEC_SUFFIXES) + "), minimise "
                        "every output exactly (or synthesise a flow table), map to library cells, "
-                       "place and dimension them, check the design, and write it as JSON. The "
-                       "output file is written atomically: on any error an existing file is "
-                       "left untouched.")
+                       "place and dimension them, check the design, prove it (logic, and "
+                       "kinematic where cheap) and write it as JSON. The output file is written "
+                       "atomically: on any error, or a failed proof, an existing file is left "
+                       "untouched. A compile that runs for more than 2 s names its stages on "
+                       "stderr.")
     c.add_argument("spec", help="specification file (" + ", ".join(SPEC_SUFFIXES) + ")")
-    c.add_argument("-o", "--output", help="output JSON file (default: SPEC with .json suffix)")
+    c.add_argument("-o", "--output", help="output JSON file (default: SPEC with .json suffix); "
+                   "a name ending in .gz is written gzip-compressed, and reads back as it is")
     compile_options(c)
     c.add_argument("--timings", action="store_true",
                    help="record seconds per stage in stats.seconds (the file then differs "
@@ -112,7 +116,7 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
               "its own proof; --no-prove writes it for inspection", file=sys.stderr)
         return EXIT_FAILED
     t0 = time.perf_counter()
-    write_atomic(out, text)
+    write_atomic(out, design_bytes(text, out))
     stages.end("write", time.perf_counter() - t0)
     print(f"{args.spec} -> {out}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
           f"{st['parts']} parts, {st['literals']} literals, {minimality(st)}, "
