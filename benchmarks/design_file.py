@@ -96,7 +96,7 @@ def old_write(obj: dict, path: Path) -> None:
 
 def new_write(obj: dict, path: Path) -> None:
     text = dumps_design(obj)
-    check_design(json.loads(text), str(path), text)
+    check_design(json.loads(text), str(path))
     data = design_bytes(text, path)  # gzip-compressed for a .gz name
     path.write_bytes(data if isinstance(data, bytes) else data.encode())
 

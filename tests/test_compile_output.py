@@ -16,13 +16,14 @@ import pytest
 
 import mechc.cli.compile as compile_cmd
 from mechc.backends.design_json import (
+    check_numbers,
     design_from_json,
     design_to_json,
     dumps,
     dumps_design,
     fast_validator,
+    has_bad_number,
     load_design_json,
-    numbers_may_be_out_of_range,
     schema,
 )
 from mechc.cells.library import load_library
@@ -115,14 +116,17 @@ def test_a_bad_file_is_refused_with_its_place(sorter_obj, tmp_path):
         load_design_json(p)
 
 
-@pytest.mark.parametrize("text, suspect", [
-    ('{"a": 1.5, "b": [2, -3.25, 1e-05]}', False),
-    ('{"a": NaN}', True), ('{"a": -Infinity}', True), ('{"a": 1e300}', True),
-    ('{"a": 12345678901}', True), ('{"a": 2E9}', True),
-])
-def test_the_number_scan_never_misses_a_number_out_of_range(text, suspect):
-    assert numbers_may_be_out_of_range(text) is suspect
-    assert numbers_may_be_out_of_range(text.encode("utf-16")) is True  # always walked
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf"), 1e300, 1.5e9,
+                                   -12345678901, np.float64("nan")])
+def test_every_number_out_of_range_is_found_with_its_place(sorter_obj, value):
+    bad = copy.deepcopy(sorter_obj)
+    bad["cells"][1]["geometry"]["bodies"][0]["outline"][0][2][1] = value
+    assert has_bad_number(bad)
+    with pytest.raises(UsageError, match=r"x.json: not a valid mechc design at "
+                       r"cells/1/geometry/bodies/0/outline/0/2/1: .* is not a finite number"):
+        check_numbers(bad, "x.json")
+    assert not has_bad_number(sorter_obj)  # True and False are no numbers out of range either
+    check_numbers(sorter_obj, "x.json")
 
 
 def test_quiet_prints_only_the_file_line_and_the_verdict(cli, tmp_path):

@@ -17,7 +17,6 @@ import gzip
 import json
 import math
 import os
-import re
 import tempfile
 import zlib
 from dataclasses import asdict, fields
@@ -253,17 +252,15 @@ def load_design_json(path: str | Path) -> dict:
     if obj.get("version") != FORMAT_VERSION:
         raise UsageError(f"{p}: design format version {obj.get('version')} is not supported "
                          f"(this mechc reads version {FORMAT_VERSION}); recompile the spec")
-    check_design(obj, str(p), data)
+    check_design(obj, str(p))
     return obj
 
 
-def check_design(obj: dict, where: str, text: bytes | str | None = None) -> None:
+def check_design(obj: dict, where: str) -> None:
     """Everything reading a design checks before any work on it: numbers in range, the schema,
     the references the schema cannot express. Compile runs it too, so it never writes a file
-    that ``simulate`` or ``draw`` would then refuse. ``text``, the JSON ``obj`` was read from,
-    lets the number check skip its walk when no number in it can be out of range."""
-    if text is None or numbers_may_be_out_of_range(text):
-        check_numbers(obj, where)
+    that ``simulate`` or ``draw`` would then refuse."""
+    check_numbers(obj, where)
     validate(obj, where)
     check_references(obj, where)
     check_cell_types(obj, where)
@@ -282,25 +279,12 @@ def check_cell_types(obj: dict, where: str) -> None:
                              f"{c['cell']!r} has no user cell file in cell_sources to declare it")
 
 
-#: Every way a JSON number can be NaN, infinite or of magnitude over 1e9 in text: a constant,
-#: ten or more digits in a row, or an exponent that is not negative (1e-05 is fine).
-_SUSPECT = re.compile(r"NaN|Infinity|[0-9]{10}|[eE]\+?[0-9]")
-
-
-def numbers_may_be_out_of_range(text: bytes | str) -> bool:
-    """False only when no number in the JSON ``text`` can fail :func:`check_numbers` (a quick
-    scan of the text instead of a walk of every value; a match anywhere, in a string too, only
-    means the walk is done). UTF-16 and UTF-32 texts are always walked."""
-    if isinstance(text, bytes):
-        if b"\x00" in text[:4]:
-            return True
-        return _SUSPECT.search(text.decode("utf-8", "replace")) is not None
-    return _SUSPECT.search(text) is not None
-
-
 def check_numbers(obj, where: str) -> None:
     """Every number finite and within MAX_MAGNITUDE. Python's json reads NaN, Infinity and
-    1e400 (as inf), and a JSON schema lets NaN through every minimum/maximum."""
+    1e400 (as inf), and a JSON schema lets NaN through every minimum/maximum. A quick walk
+    decides (0.3 s on a 4 MB design); only a design that fails is walked again for the path."""
+    if not has_bad_number(obj):
+        return
     todo: list[tuple[object, tuple]] = [(obj, ())]
     while todo:
         o, path = todo.pop()
@@ -313,6 +297,29 @@ def check_numbers(obj, where: str) -> None:
             loc = "/".join(str(k) for k in path) or "(top level)"
             raise UsageError(f"{where}: not a valid mechc design at {loc}: {o} is not a finite "
                              f"number of magnitude at most {MAX_MAGNITUDE:g}")
+
+
+def has_bad_number(obj) -> bool:
+    """Whether any number in ``obj`` is NaN, infinite or of magnitude over MAX_MAGNITUDE
+    (containers only on the stack, no paths: four times faster than the walk with paths)."""
+    m = MAX_MAGNITUDE
+    stack = [obj]
+    while stack:
+        o = stack.pop()
+        for v in (o.values() if isinstance(o, dict) else o):
+            t = type(v)
+            if t is float:
+                if not -m <= v <= m:  # NaN fails both comparisons
+                    return True
+            elif t is int:
+                if v > m or v < -m:
+                    return True
+            elif t is dict or t is list:
+                stack.append(v)
+            elif t is not str and t is not bool and isinstance(v, (int, float)):
+                if not -m <= float(v) <= m:  # a numpy scalar, in a design not yet written
+                    return True
+    return False
 
 
 def check_references(obj: dict, where: str) -> None:

@@ -91,12 +91,12 @@ def run(args: argparse.Namespace) -> int:
 def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress) -> int:
     """Compile, check, prove, write and summarise (see ``run``)."""
     design = compile_path(args.spec, args, stages=stages)
-    stages.start("write")
+    stages.start("check file")
     t0 = time.perf_counter()
     text = dumps_design(design_to_json(design, timings=args.timings))
     obj = json.loads(text)  # what is checked and proved is what the file will hold
     try:  # the same checks simulate and draw make on reading it, before anything is written
-        check_design(obj, out, text)
+        check_design(obj, out)
     except UsageError as e:
         raise UsageError(f"refusing to write {out}: {str(e).removeprefix(out + ': ')} (the "
                          f"options asked for more than a design can carry: --output-load "
@@ -115,6 +115,7 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
         print(f"{out} was NOT written (an existing file there is unchanged): the design fails "
               "its own proof; --no-prove writes it for inspection", file=sys.stderr)
         return EXIT_FAILED
+    stages.start("write")
     t0 = time.perf_counter()
     write_atomic(out, design_bytes(text, out))
     stages.end("write", time.perf_counter() - t0)
