@@ -8,7 +8,7 @@ and still diffs line by line (benchmarks/design_file.py). Reading validates agai
 with jsonschema-rs, and only on a failure with the pure-Python jsonschema, whose error path and
 message the user sees: the same verdict and message as before, a hundred times faster on a
 large design. Any valid JSON layout loads, indented files of earlier versions included, and a
-design written as ``NAME.json.gz`` is the same text gzip-compressed (about 7 times smaller again).
+design written as ``NAME.json.gz`` is the same text gzip-compressed (9 times smaller again).
 """
 
 from __future__ import annotations
@@ -202,8 +202,8 @@ def fast_validator():
 
 def validate(obj: dict, where: str) -> None:
     """Against the schema: jsonschema-rs decides (0.2 s where jsonschema takes 19 s on an 80 MB
-    design); a design it rejects is validated again by jsonschema for the message, which names
-    the first wrong place by its path."""
+    design); a design it rejects is validated again by jsonschema for the message, which
+    names the first wrong place by its path."""
     try:
         if fast_validator().is_valid(obj):
             return
