@@ -42,9 +42,17 @@ class CompileOptions:
     timings: bool = False  # record seconds per stage in the JSON (makes output non-reproducible)
 
 
+#: Told when a stage ends: its name and its seconds (the terminal's progress, a benchmark).
+OnStageDone = Callable[[str, float], None]
+
+
 def compile_spec(spec: Spec, opts: CompileOptions | None = None,
                  library: Library | None = None,
-                 progress: Callable[[str], None] | None = None) -> Design:
+                 progress: Callable[[str], None] | None = None,
+                 done: OnStageDone | None = None) -> Design:
+    """Every stage in order. ``progress`` is told each stage's name as it starts, ``done`` its
+    name and seconds as it ends (a stage that runs more than once, as assemble may, is told
+    each time; ``Design.seconds`` holds the last)."""
     opts = opts or CompileOptions()
     lib = library or load_library(opts.cell_dirs)
     seconds: dict[str, float] = {}
@@ -55,6 +63,8 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
         t0 = time.perf_counter()
         out = fn(*args)
         seconds[name] = time.perf_counter() - t0
+        if done:
+            done(name, seconds[name])
         return out
 
     if getattr(spec, "kind", "") == "fsm":

@@ -153,22 +153,23 @@ def _recorder(args: argparse.Namespace, design: Design) -> pose_trace.TraceRecor
 def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: Library,
            trace: pose_trace.TraceRecorder | None = None) -> ProofReport:
     """The proof at ``args.level`` of ``design`` against ``spec`` (a ProofReport), with a
-    progress bar while a dynamic proof runs."""
+    progress bar while a kinematic or dynamic proof runs (shown after 1.5 s)."""
     settings = ProofSettings(tolerance=args.tolerance, seed=args.seed, cases=args.cases,
                              prune=args.prune, accuracy=args.accuracy, dt=args.dt,
                              iterations=args.iterations, move_time=args.move_time,
                              trace=trace, jobs=args.jobs or available_cores(),
                              scheduler=args.scheduler)
-    if args.level != "dynamic":
+    if args.level == "logic":
         return prove(design, spec, lib, args.level, settings)
-    what = "sequential dynamic" if spec_kind(spec) == "sequential" else "dynamic"
+    what = ("sequential " if spec_kind(spec) == "sequential" else "") + args.level
     where = (f" on {args.scheduler}" if args.scheduler
-             else f" on {settings.jobs} processes" if settings.jobs > 1 and not trace else "")
+             else f" on {settings.jobs} processes"
+             if args.level == "dynamic" and settings.jobs > 1 and not trace else "")
     bar = Progress(1, f"{what} proof of {Path(args.design).name}{where}")
 
     def tick(done: int, total: int) -> None:
         bar.total = total
-        bar.update(done, "input changes")
+        bar.update(done, "input changes" if args.level == "dynamic" else "states")
 
     try:
         return prove(design, spec, lib, args.level, settings, tick)
