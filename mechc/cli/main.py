@@ -9,7 +9,7 @@ import sys
 import traceback
 
 from mechc import __version__
-from mechc.cli import bench, cells, draw, new_cell, simulate, synth, tolerance
+from mechc.cli import bench, cells, draw, export, new_cell, simulate, synth, tolerance, view
 from mechc.cli import compile as compile_cmd
 from mechc.errors import (
     EXIT_INTERNAL,
@@ -25,6 +25,8 @@ mechanical cells (sliders, levers, springs) with their geometry, and a simulatio
   mechc compile sorter.bool -o sorter.json     spec -> mechanism JSON (netlist + geometry)
   mechc simulate sorter.json                   prove it (levels: logic, kinematic, dynamic)
   mechc draw sorter.json -o sorter.svg         look at it
+  mechc export sorter.json -o sorter.dxf       make it: cut sheets, parts list, 3D model
+  mechc view sorter.json -o sorter.html        watch it move (a page for any browser)
   mechc cells                                  list the cell library
   mechc tolerance sorter.json                  yield as made: tolerances, pin play, springs
 
@@ -69,6 +71,8 @@ def build_parser() -> argparse.ArgumentParser:
     cells.register(sub)
     new_cell.register(sub)
     draw.register(sub)
+    export.register(sub)
+    view.register(sub)
     synth.register(sub)
     bench.register(sub)
     tolerance.register(sub)
