@@ -80,6 +80,7 @@ def net_rods(part: Part) -> list[NetRod]:
                              f"load (has {len(to_driver)} and {len(to_load)})")
         jd, jl = to_driver[0], to_load[0]
         length = np.hypot(jl.pa[0] - jd.pa[0], jl.pa[1] - jd.pa[1])  # arrays in a tolerance run
+        length = float(length) if np.ndim(length) == 0 else length  # a number stays a number
         out.append(NetRod(b.id, jd.a, jl.b, jd.pa, jl.pa, length, b.id, (jd, jl)))
     return out
 
