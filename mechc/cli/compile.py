@@ -25,6 +25,7 @@ from mechc.cli.common import (
     compile_options,
     compile_path,
 )
+from mechc.cli.tolerance import robust_design, robust_options, wants_robust
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
 from mechc.frontends import SPEC_SUFFIXES
 from mechc.ir.design import Design
@@ -52,6 +53,7 @@ def register(sub) -> None:
                    "from run to run)")
     c.add_argument("--print-netlist", action="store_true",
                    help="also print the netlist in canonical text form")
+    robust_options(c)
     c.add_argument("-q", "--quiet", action="store_true",
                    help="print only the file line and the verdict (no equations, no progress); "
                    "errors and failures are still printed")
@@ -90,7 +92,11 @@ def run(args: argparse.Namespace) -> int:
 
 def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress) -> int:
     """Compile, check, prove, write and summarise (see ``run``)."""
-    design = compile_path(args.spec, args, stages=stages)
+    met = True
+    if wants_robust(args):  # --tol/--yield: dimensions chosen by tolerance runs
+        design, met = robust_design(args)
+    else:
+        design = compile_path(args.spec, args, stages=stages)
     stages.start("check file")
     t0 = time.perf_counter()
     text = dumps_design(design_to_json(design, timings=args.timings))
@@ -142,7 +148,7 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
     summary = stages.summary()
     if summary and not args.quiet:
         print(summary, file=sys.stderr)
-    return EXIT_OK
+    return EXIT_OK if met else EXIT_FAILED
 
 
 def check_failures(dc: dict, what: str) -> None:

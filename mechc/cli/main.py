@@ -9,7 +9,7 @@ import sys
 import traceback
 
 from mechc import __version__
-from mechc.cli import bench, cells, draw, export, new_cell, simulate, synth, view
+from mechc.cli import bench, cells, draw, export, new_cell, simulate, synth, tolerance, view
 from mechc.cli import compile as compile_cmd
 from mechc.errors import (
     EXIT_INTERNAL,
@@ -28,6 +28,7 @@ mechanical cells (sliders, levers, springs) with their geometry, and a simulatio
   mechc export sorter.json -o sorter.dxf       make it: cut sheets, parts list, 3D model
   mechc view sorter.json -o sorter.html        watch it move (a page for any browser)
   mechc cells                                  list the cell library
+  mechc tolerance sorter.json                  yield as made: tolerances, pin play, springs
 
 Exit status: 0 success, 1 a proof or design check failed, 2 bad input, 3 internal error.
 """
@@ -74,6 +75,7 @@ def build_parser() -> argparse.ArgumentParser:
     view.register(sub)
     synth.register(sub)
     bench.register(sub)
+    tolerance.register(sub)
     return p
 
 

@@ -53,8 +53,17 @@ def cross(a, b):
 
 
 def unit(v):
-    n = float(np.hypot(v[0], v[1]))
+    n = np.hypot(v[0], v[1])  # no float(): a tolerance run gives dimensions as arrays
     return (v[0] / n, v[1] / n)
+
+
+def side_of(v):
+    """The sign of ``v`` with 0 read as +1 (a branch chosen at the design pose): a float for a
+    number, an array where the dimensions are arrays (``mechc.tolerance`` perturbs them per
+    sample)."""
+    if np.ndim(v) == 0:
+        return float(np.sign(v)) or 1.0
+    return np.where(np.asarray(v) < 0, -1.0, 1.0)
 
 
 def direction(v) -> Point:
@@ -122,8 +131,13 @@ def lever_arm(body: Body | None, poses: Poses, p) -> Coords | None:
     return None if body is None else BODY_KINDS[body.kind].arm(body, poses, p)
 
 
-def placed_key(body: Body | None, p: Point) -> tuple[str, float, float]:
-    return (GROUND if body is None else body.id, float(p[0]), float(p[1]))
+def placed_key(body: Body | None, p: Point) -> tuple:
+    """The key of a design point of ``body``; a point given as arrays (one value per sample
+    of a tolerance run) is keyed by the arrays' identity."""
+    bid = GROUND if body is None else body.id
+    if np.ndim(p[0]) or np.ndim(p[1]):
+        return (bid, id(p[0]), id(p[1]))
+    return (bid, float(p[0]), float(p[1]))
 
 
 def placed_position(body: Body | None, poses: Poses, p: Point) -> Coords:

@@ -47,7 +47,7 @@ class Contact(JointKind):
         ax_, ay_ = position(a, poses, j.pa)
         bx_, by_ = position(b, poses, j.pb)
         gap = (bx_ - ax_) * j.normal[0] + (by_ - ay_) * j.normal[1]
-        return np.broadcast_to(gap < -tol * max(1.0, abs(j.pa[0])), (size,))
+        return np.broadcast_to(gap < -tol * np.maximum(1.0, np.abs(j.pa[0])), (size,))
 
     @classmethod
     def ground_point(cls, j: Joint) -> Point | None:

@@ -20,6 +20,7 @@ from mechc.parts.base import (
     lever_arm,
     line_cotan,
     position,
+    side_of,
     unit,
 )
 from mechc.parts.poses import KinematicsError, Poses
@@ -33,15 +34,15 @@ def lever_from_slot(j: Joint, lever: Body, slot_body: Body | None, poses: Poses,
     r = (j.q[0] - P[0], j.q[1] - P[1])
     a = cross(r, d)
     b = -(r[0] * d[0] + r[1] * d[1])
-    rho = float(np.hypot(a, b))
-    phi = float(np.arctan2(b, a))
+    rho = np.hypot(a, b)  # arrays in a tolerance run (a value per sample)
+    phi = np.arctan2(b, a)
     x0, y0 = position(slot_body, poses, j.p0)
     c = (x0 - P[0]) * d[1] - (y0 - P[1]) * d[0]
     if slot_body is not None and slot_body.kind == "lever":
         raise KinematicsError(f"{j.id}: slot on a lever driving a lever is not supported")
     ratio = np.broadcast_to(c / rho, (size,))
     ok = np.abs(ratio) <= 1.0
-    s = -1.0 if phi > 0 else 1.0
+    s = -side_of(phi)  # -1 for phi > 0, else +1
     theta = phi + s * np.arccos(np.clip(ratio, -1.0, 1.0))
     theta = (theta + np.pi) % (2 * np.pi) - np.pi
     poses.theta[lever.id] = np.where(ok, theta, np.nan)
@@ -60,7 +61,7 @@ def slot_from_pin(j: Joint, slider: Body, pin_body: Body | None, poses: Poses,
     d = unit((j.p1[0] - j.p0[0], j.p1[1] - j.p0[1]))
     qx, qy = position(pin_body, poses, j.q)
     den = cross(slider.axis, d)
-    if abs(den) < 1e-12:
+    if np.any(np.abs(den) < 1e-12):
         raise KinematicsError(f"{j.id}: slot parallel to its slider's travel")
     u = ((qx - j.p0[0]) * d[1] - (qy - j.p0[1]) * d[0]) / den
     poses.u[slider.id] = np.broadcast_to(u, (size,)).copy()
@@ -89,7 +90,7 @@ class Groove(JointKind):
         qx, qy = position(b, poses, j.q)
         off = (qx - x0) * d[1] - (qy - y0) * d[0]
         along = (qx - x0) * d[0] + (qy - y0) * d[1]
-        length = float(np.hypot(j.p1[0] - j.p0[0], j.p1[1] - j.p0[1]))
+        length = np.hypot(j.p1[0] - j.p0[0], j.p1[1] - j.p0[1])
         return np.broadcast_to((np.abs(off) > 1e-6) | (along < -1e-6)
                                | (along > length + 1e-6), (size,))
 

@@ -79,7 +79,8 @@ def net_rods(part: Part) -> list[NetRod]:
             raise ValueError(f"{b.id}: a net rod needs one pin from its driver and one to its "
                              f"load (has {len(to_driver)} and {len(to_load)})")
         jd, jl = to_driver[0], to_load[0]
-        length = math.hypot(jl.pa[0] - jd.pa[0], jl.pa[1] - jd.pa[1])
+        length = np.hypot(jl.pa[0] - jd.pa[0], jl.pa[1] - jd.pa[1])  # arrays in a tolerance run
+        length = float(length) if np.ndim(length) == 0 else length  # a number stays a number
         out.append(NetRod(b.id, jd.a, jl.b, jd.pa, jl.pa, length, b.id, (jd, jl)))
     return out
 
@@ -90,7 +91,7 @@ def pose_rod_body(rod: NetRod, body: Body, driver: Body, load: Body, poses: Pose
     already solved)."""
     ax, ay = position(driver, poses, rod.pa)
     bx, by = position(load, poses, rod.pb)
-    th = np.arctan2(by - ay, bx - ax) - math.atan2(rod.pb[1] - rod.pa[1], rod.pb[0] - rod.pa[0])
+    th = np.arctan2(by - ay, bx - ax) - np.arctan2(rod.pb[1] - rod.pa[1], rod.pb[0] - rod.pa[0])
     th = (th + np.pi) % (2 * np.pi) - np.pi
     th, ax, ay = (np.broadcast_to(v, (size,)) for v in (th, ax, ay))
     ok = np.isfinite(th) & np.isfinite(ax) & np.isfinite(ay)

@@ -24,6 +24,7 @@ from mechc.parts.base import (
     placed_position,
     position,
     ratio_tan,
+    side_of,
 )
 from mechc.parts.poses import Poses
 
@@ -39,7 +40,7 @@ def slider_from_rod(j: Joint, slider: Body, other: Body | None, poses: Poses,
     we = wx * e[0] + wy * e[1]
     disc = we * we - (wx * wx + wy * wy) + j.length ** 2
     we0 = (mine[0] - theirs[0]) * e[0] + (mine[1] - theirs[1]) * e[1]
-    s = 1.0 if we0 >= 0 else -1.0
+    s = side_of(we0)
     ok = disc >= 0
     u = -we + s * np.sqrt(np.where(ok, disc, 0.0))
     poses.u[slider.id] = np.where(ok, u, np.nan) * np.ones(size)
@@ -88,19 +89,23 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
         # toggle (fmax takes 0 over H's NaN there); kept as its tangent |arm×rod| / |arm·rod|
         # (the check converts the smallest only)
         gamma = ratio_tan(np.fmax(H, 0.0), np.abs(0.5 - 0.5 * (r2 + L2) * inv))
-    side = float(np.sign(cross((theirs[0] - P[0], theirs[1] - P[1]),
-                                (mine[0] - P[0], mine[1] - P[1])))) or 1.0
+    side = side_of(cross((theirs[0] - P[0], theirs[1] - P[1]), (mine[0] - P[0], mine[1] - P[1])))
     rx, ry = A * dx, A * dy
-    if side > 0:
+    if np.ndim(side):  # dimensions as arrays (a tolerance run): the branch per sample
+        rx -= side * H * dy
+        ry += side * H * dx
+    elif side > 0:
         rx -= H * dy
         ry += H * dx
     else:
         rx += H * dy
         ry -= H * dx
-    phi0 = float(np.arctan2(mine[1] - P[1], mine[0] - P[0]))
+    phi0 = np.arctan2(mine[1] - P[1], mine[0] - P[0])
     theta = np.arctan2(ry, rx)
     theta -= phi0  # in [-pi - phi0, pi - phi0]: wrap the one side that can leave [-pi, pi)
-    if phi0 > 0:
+    if np.ndim(phi0):
+        theta = (theta + np.pi) % (2 * np.pi) - np.pi
+    elif phi0 > 0:
         np.add(theta, 2 * np.pi, out=theta, where=theta < -np.pi)
     else:
         np.subtract(theta, 2 * np.pi, out=theta, where=theta >= np.pi)
@@ -135,7 +140,9 @@ class Rod(JointKind):
         g2 = ex * ex
         g2 += ey * ey
         viol = g2 > (j.length + 1e-6) ** 2
-        if j.length > 1e-6:
+        if np.ndim(j.length):  # a length per sample (a tolerance run)
+            viol |= (j.length > 1e-6) & (g2 < (j.length - 1e-6) ** 2)
+        elif j.length > 1e-6:
             viol |= g2 < (j.length - 1e-6) ** 2
         return np.broadcast_to(viol, (size,))
 

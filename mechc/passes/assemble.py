@@ -43,6 +43,8 @@ class MechOptions:
     output_load: float = 0.5  # N, what each circuit output must move, either way
     clearance: float = 1.0  # mm, least gap between parts on one plane (a design rule)
     material: str = DEFAULT_MATERIAL  # plate material (mechc/cells/materials.py)
+    spring_margin: float = 1.3  # spring preload >= this x what it must move (SynthContext)
+    overtravel: float = 0.02  # over-travel stops, fraction of stroke beyond the working range
 
 
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
@@ -50,7 +52,8 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
     opts = opts or MechOptions()
     mat = material(opts.material)
     ctx = SynthContext(stroke=opts.stroke, density=mat.density, material=mat.name,
-                       clearance=opts.clearance)
+                       clearance=opts.clearance, margin=opts.spring_margin,
+                       overtravel=opts.overtravel)
     S, w = ctx.stroke, ctx.bar
     order = [c.id for c in nl.topo_cells()]
     cells = {c.id: c for c in nl.cells.values()}

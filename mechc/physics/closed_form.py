@@ -20,7 +20,14 @@ import numpy as np
 from mechc.geometry.circles import circle_meeting
 from mechc.ir.mechanism import GROUND, Body, Joint, Part
 from mechc.parts import body_kind, joint_kind
-from mechc.parts.base import body_or_ground, cross, displacement, line_tan, position
+from mechc.parts.base import (
+    body_or_ground,
+    cross,
+    displacement,
+    line_tan,
+    position,
+    side_of,
+)
 from mechc.parts.poses import KinematicsError, Poses, cos_sin
 
 # the closed form's public names (``Poses``, ``position``, ... live with the parts and poses)
@@ -118,11 +125,12 @@ def _try_solve(part, b: Body, bodies, by_body: dict[str, list[Joint]], poses: Po
             hi = np.minimum(hi, bound)
         bad |= np.broadcast_to(poses.bad.get(other, np.zeros(size, bool)), (size,))
     u = lo if sign < 0 else hi
-    if not np.isfinite(u).all():
+    if np.isinf(u).any():
         raise KinematicsError(f"{b.id}: its spring pushes it towards a side with no stop")
     jam = lo > hi + 1e-9
     poses.u[b.id] = np.where(jam, np.nan, u)
-    poses.mark(b.id, bad | jam)
+    # NaN: a limit from a body no closed form could place in that state (upstream bad)
+    poses.mark(b.id, bad | jam | np.isnan(u))
     return True
 
 
@@ -151,11 +159,10 @@ def _try_dyad(b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
             continue
         P0 = j.pa
         (A0, ax, ay, abad, _), (B0, bx, by, bbad, _) = mine, theirs
-        r1 = float(np.hypot(P0[0] - A0[0], P0[1] - A0[1]))
-        r2 = float(np.hypot(P0[0] - B0[0], P0[1] - B0[1]))
+        r1 = np.hypot(P0[0] - A0[0], P0[1] - A0[1])  # arrays in a tolerance run
+        r2 = np.hypot(P0[0] - B0[0], P0[1] - B0[1])
         # the pin is where the two circles meet, on the side it has at the design pose
-        side = float(np.sign(cross((B0[0] - A0[0], B0[1] - A0[1]),
-                                   (P0[0] - A0[0], P0[1] - A0[1])))) or 1.0
+        side = side_of(cross((B0[0] - A0[0], B0[1] - A0[1]), (P0[0] - A0[0], P0[1] - A0[1])))
         centres_a = np.stack(np.broadcast_arrays(ax, ay), axis=-1)
         centres_b = np.stack(np.broadcast_arrays(bx, by), axis=-1)
         pin, h2 = circle_meeting(centres_a, r1, centres_b, r2, side, miss="clamp")
