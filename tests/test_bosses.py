@@ -114,7 +114,7 @@ def test_a_pin_past_the_end_of_a_bar_gets_a_boss_joined_to_it():
     assert r == max(ctx.pin_diameter, ctx.thickness)
     for c in ((34.0, 3.0), (15.0, 6.0)):
         assert whole.contains(Point(c).buffer(r - 1e-6))
-    assert b.poly_layers == [2, 2, 2]
+    assert b.poly_layers is None  # all on its one plane
     extra = whole.area - Polygon(bar).area
     assert b.mass == pytest.approx(m0 + extra * ctx.thickness * ctx.density, rel=1e-6)
     lv = unary_union([Polygon(p) for p in lever.outline])
@@ -127,3 +127,23 @@ def test_a_pin_held_already_gets_no_boss():
     g = Polygon([(0, 0), (30, 0), (30, 6), (0, 6)])
     assert boss(g, (15.0, 3.0), boss_radius(3.0, ctx)) is None
     assert boss(g, (15.0, 2.0), boss_radius(3.0, ctx)) is not None  # 2 mm from the edge
+
+
+def test_a_boss_that_would_hit_a_neighbour_goes_on_another_plane():
+    """A pin 4 mm past a slider's end where another slider lies on the same plane: the boss
+    would overlap it, so it goes on the plane where nothing comes within a stroke (a doubler
+    plate), and the slider's first polygon keeps its plane."""
+    ctx = SynthContext()
+    bar = [(0.0, 0.0), (30.0, 0.0), (30.0, 6.0), (0.0, 6.0)]
+    s = Body("s", "slider", [bar], ctx.mass([bar]), axis=(1.0, 0.0), layer=0)
+    n = Body("n", "slider", [[(33.0, -10.0), (40.0, -10.0), (40.0, 20.0), (33.0, 20.0)]], 0.0,
+             axis=(1.0, 0.0), layer=0)
+    far = Body("f", "slider", [[(200.0, 0.0), (230.0, 0.0), (230.0, 6.0), (200.0, 6.0)]], 0.0,
+               axis=(1.0, 0.0), layer=1)
+    part = Part(bodies=[s, n, far], joints=[Joint("j", "pin", "ground", "s", pa=(34.0, 3.0))])
+    mech = Mechanism(ctx, {"c": part}, {}, {}, {}, {}, ["c"], [])
+    assert add_bosses(mech) == [("s", 1)]
+    assert s.poly_layers == [0, 1]
+    g = Polygon(s.outline[1])
+    assert g.contains(Point(34.0, 3.0).buffer(boss_radius(ctx.pin_diameter, ctx) - 1e-6))
+    assert g.intersects(Polygon(bar))  # it lies over the slider's plate, fastened to it
