@@ -42,9 +42,17 @@ class CompileOptions:
     timings: bool = False  # record seconds per stage in the JSON (makes output non-reproducible)
 
 
+#: Told when a stage ends: its name and its seconds (the terminal's progress, a benchmark).
+OnStageDone = Callable[[str, float], None]
+
+
 def compile_spec(spec: Spec, opts: CompileOptions | None = None,
                  library: Library | None = None,
-                 progress: Callable[[str], None] | None = None) -> Design:
+                 progress: Callable[[str], None] | None = None,
+                 done: OnStageDone | None = None) -> Design:
+    """Every stage in order. ``progress`` is told each stage's name as it starts, ``done`` its
+    name and seconds as it ends (a stage that runs more than once, as assemble may, is told
+    each time; ``Design.seconds`` holds the last)."""
     opts = opts or CompileOptions()
     lib = library or load_library(opts.cell_dirs)
     seconds: dict[str, float] = {}
@@ -55,17 +63,23 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
         t0 = time.perf_counter()
         out = fn(*args)
         seconds[name] = time.perf_counter() - t0
+        if done:
+            done(name, seconds[name])
         return out
 
     if getattr(spec, "kind", "") == "fsm":
         return compile_sequential(spec, opts, lib, stage=stage, seconds=seconds)
     eq = stage("minimise", minimise, spec, opts.minimise)
     mapped = stage("map", map_equations, eq, lib, opts.map)
+    if getattr(mapped, "equations", None) is not None:
+        eq = mapped.equations  # the mapper built the alternative covers (fewer parts)
     layout = stage("place", place, mapped.netlist)
     nl, layout, mech, amps = stage("assemble", assemble_powered, mapped.netlist, lib, opts,
                                    layout)
     stats = design_stats(eq, nl, lib, layout)
     stats.update(interconnect_stats(mech))
+    if getattr(spec, "display", None):
+        stats["names"] = dict(spec.display)  # safe identifier -> the spec file's own name
     if amps:
         stats["amplified"] = amps
     design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
@@ -216,6 +230,7 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
         "cells_by_type": nl.count_by_type(),
         "parts": parts,
         "terms": eq.terms,
+        "products": eq.products,
         "literals": eq.literals,
         "shared_terms": eq.shared_terms,
         "depth": max(nl.depth().values(), default=0),
@@ -224,5 +239,6 @@ def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None
                          "verified": "exhaustive" if all(c.method != "espresso" for c in
                                                          eq.covers.values())
                          else "exact on cubes",
+                         "time_limited": list(eq.time_limited),
                          "outputs": per_output},
     }

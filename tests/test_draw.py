@@ -298,3 +298,131 @@ def test_unsolved_body_is_shown_and_fails(cli, sorter, sorter_json, tmp_path, mo
     texts = [t.text or "" for t in root.iter(f"{NS}text")]
     assert any("NOT SOLVED" in t for t in texts)
     assert "Z = ? (not solved)" in texts and _outputs(svg) == {}
+
+
+# ---- drawings that read at any size -----------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def big():
+    """A compiled design of about a hundred cells (a random spec, grown to size)."""
+    from mechc.bench.circuits import random_compiled
+
+    d = random_compiled(100, seed=1)
+    assert 75 <= len(d.netlist.cells) <= 125
+    return d
+
+
+def _font_px(style: str, selector: str) -> float:
+    m = re.search(r"(?:^|\})" + re.escape(selector) + r"\{font-size:([\d.]+)px", style)
+    assert m, selector
+    return float(m.group(1))
+
+
+def _body_x_extent(root) -> tuple[float, float]:
+    xs = []
+    for g in root.iter(f"{NS}g"):
+        if g.get("data-body"):
+            for p in g:
+                if p.get("class") == "f":
+                    xs += [float(v) for v in re.findall(r"[ML]([-\d.]+),", p.get("d"))]
+    return min(xs), max(xs)
+
+
+@pytest.mark.parametrize("which", ["sorter", "big"])
+def test_drawing_reads_on_one_screen(which, request):
+    """Shown at its default size (at most one 1600 px screen wide), the input and output
+    labels are at least 16 px tall and the cell names 11 px; every cell has its box and its
+    name by it; the inputs are named in a column left of every part, the outputs right of
+    every part, one label each, not on top of each other; the legend names the cells' boxes."""
+    design = request.getfixturevalue(which)
+    svg = draw_svg(design, {})
+    root = ET.fromstring(svg)
+    shown = float(root.get("width"))
+    assert 200 <= shown <= 1600
+    d = shown / float(root.get("viewBox").split()[2])  # screen px per drawing unit
+    if which == "big":
+        assert d < 0.5  # a design this size is shown shrunk: the text must be sized for it
+    style = root.find(f"{NS}style").text
+    io_px, cell_px = _font_px(style, ".io text") * d, _font_px(style, "text") * d
+    assert io_px >= 16 and cell_px >= 11, (io_px, cell_px)
+    texts = [t for t in root.iter(f"{NS}text") if "halo" not in (t.get("class") or "")]
+    # every cell: a box, and its name at the box's top left
+    rects = {r.get("data-cell"): r for r in root.iter(f"{NS}rect") if r.get("data-cell")}
+    assert set(rects) == set(design.netlist.cells)
+    fs = cell_px / d
+    for cid, r in rects.items():
+        x, y = float(r.get("x")), float(r.get("y"))
+        lab = [t for t in texts if (t.text or "").startswith(f"{cid} ")
+               and t.get("class") == "lc"]
+        assert len(lab) == 1, cid
+        assert lab[0].text == f"{cid} {design.netlist.cells[cid].type}"
+        lx, ly = float(lab[0].get("x")), float(lab[0].get("y"))
+        assert abs(lx - x) < fs and y - 6 * fs <= ly <= y + float(r.get("height")), cid
+    # inputs and outputs at the edges, one label each
+    x0, x1 = _body_x_extent(root)
+    io = [t for t in texts if "iol" in (t.get("class") or "") or "ior" in (t.get("class") or "")]
+    left = {t.text.split()[0]: t for t in io if "iol" in t.get("class")}
+    right = {t.text.split()[0]: t for t in io if "ior" in t.get("class")}
+    assert set(left) == set(design.netlist.inputs)
+    assert set(right) == set(design.mechanism.outputs)
+    for t in left.values():
+        assert t.get("text-anchor") == "end" and float(t.get("x")) < x0
+    for t in right.values():
+        assert t.get("text-anchor") == "start" and float(t.get("x")) > x1
+    fio = io_px / d
+    for side in (left, right):
+        ys = sorted(float(t.get("y")) for t in side.values())
+        assert all(b - a >= 1.1 * fio for a, b in zip(ys, ys[1:]))
+    legend = " ".join(t.text or "" for g in root.iter(f"{NS}g") if g.get("class") == "legend"
+                      for t in g.iter(f"{NS}text"))
+    assert "input slider" in legend and "cell: id TYPE" in legend
+
+
+def test_natural_size_keeps_scale_and_small_drawings_are_not_blown_up(sorter):
+    """--width 0 (None): the drawing's own size, scale px per mm; a drawing narrower than the
+    width is shown at its own size too (never enlarged)."""
+    nat = ET.fromstring(draw_svg(sorter, {}, 2.0, width=None))
+    assert float(nat.get("width")) == float(nat.get("viewBox").split()[2])
+    small = ET.fromstring(draw_svg(sorter, {}, 0.5))
+    assert float(small.get("width")) == float(small.get("viewBox").split()[2]) < 1600
+
+
+@pytest.mark.parametrize("which", ["sorter", "big"])
+def test_drawing_as_chromium_shows_it(which, request, browser, tmp_path):
+    """The SVG opened in a real browser at its own size (what a person sees at 100 % zoom):
+    the input and output labels render at least 16 px tall and the cell names 10 px, no text
+    is cut off by the picture's edge, the io labels do not overlap one another, and the parts
+    lie between the input column and the output column."""
+    design = request.getfixturevalue(which)
+    path = tmp_path / "d.svg"
+    path.write_text(draw_svg(design, {}))
+    root = ET.fromstring(path.read_text())
+    w, h = float(root.get("width")), float(root.get("height"))
+    page = browser.new_page(viewport={"width": int(w) + 1, "height": int(h) + 1})
+    page.goto(path.resolve().as_uri())
+    got = page.evaluate("""() => {
+        const r = e => { const b = e.getBoundingClientRect();
+                         return [b.left, b.top, b.right, b.bottom]; };
+        const texts = [...document.querySelectorAll('text')]
+            .filter(t => !t.classList.contains('halo'))
+            .map(t => [t.getAttribute('class') || '', t.textContent, ...r(t)]);
+        const bodies = [...document.querySelectorAll('g[data-body]')].map(r);
+        return {texts, bodies};
+    }""")
+    page.close()
+    texts, bodies = got["texts"], got["bodies"]
+    for _cls, text, x0, y0, x1, y1 in texts:
+        assert -0.5 <= x0 and x1 <= w + 0.5 and -0.5 <= y0 and y1 <= h + 0.5, (text, x0, x1)
+    io = [t for t in texts if "iol" in t[0] or "ior" in t[0]]
+    cells = [t for t in texts if t[0] == "lc"]
+    assert len(io) == len(design.netlist.inputs) + len(design.mechanism.outputs)
+    assert len(cells) == len(design.netlist.cells)
+    assert min(t[5] - t[3] for t in io) >= 16
+    assert min(t[5] - t[3] for t in cells) >= 10
+    for i, a in enumerate(io):
+        for b in io[i + 1:]:
+            assert a[4] <= b[2] or b[4] <= a[2] or a[5] <= b[3] or b[5] <= a[3], (a[1], b[1])
+    left = min(b[0] for b in bodies)
+    right = max(b[2] for b in bodies)
+    assert max(t[4] for t in io if "iol" in t[0]) < left
+    assert min(t[2] for t in io if "ior" in t[0]) > right

@@ -90,14 +90,16 @@ def sop_cost(expr) -> tuple[int, int]:
 def test_random_specs_equivalent_and_no_worse_than_sopform(seed):
     """4-10 inputs, 1-4 outputs, with don't-cares: every care row right (checked here by direct
     evaluation of the printed equation with sympy, independently of mechc's own verifier), and
-    literal counts no worse than sympy's SOPform (run where it is fast: n <= 7)."""
+    literal counts no worse than sympy's SOPform (run where it is fast: n <= 7). SOPform
+    minimises each output alone, so the comparison is with the per-output minimiser
+    (``multi_output=False``); the multi-output covers are checked in test_multi_output.py."""
     rng = np.random.default_rng(1000 + seed)
     n = int(rng.integers(4, 11))
     m = int(rng.integers(1, 5))
     tables = {f"f{j}": random_table(rng, n, p_on=float(rng.uniform(0.1, 0.6)),
                                     p_dc=float(rng.uniform(0, 0.25))) for j in range(m)}
     spec = spec_from_tables(tables, n)
-    eq = minimise(spec, MinimiseOptions(time_limit=4, alt_time_limit=1))
+    eq = minimise(spec, MinimiseOptions(time_limit=4, alt_time_limit=1, multi_output=False))
     syms = sympy.symbols(spec.inputs)
     env = dict(zip(spec.inputs, syms))
     from mechc.ir import expr as ex
@@ -189,3 +191,28 @@ def test_wide_complement_is_cubes_not_minterms():
         for c in cover.cubes:
             got |= (pts & c.mask) == c.value
         assert np.array_equal(got, want)
+
+
+def test_mapper_builds_whichever_covers_cost_fewer_parts():
+    """Multi-output covers travel with the per-output ones as an alternative; the mapper keeps
+    the design with fewer parts (each mapped alone here as the reference) and says which
+    equations it built."""
+    from dataclasses import replace
+
+    from mechc.cells.library import load_library
+    from mechc.frontends.pla import parse_pla_file
+    from mechc.passes.map import map_equations
+
+    lib = load_library()
+
+    def parts(m):
+        return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values())
+
+    spec = parse_pla_file("tests/logic/pla/square5.pla")
+    eq = minimise(spec)
+    assert eq.alternative is not None
+    alone = parts(map_equations(replace(eq, alternative=None), lib))
+    other = parts(map_equations(eq.alternative, lib))
+    got = map_equations(eq, lib)
+    assert parts(got) == min(alone, other)
+    assert (got.equations is eq.alternative) == (other < alone)

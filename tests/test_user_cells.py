@@ -192,8 +192,13 @@ def test_a_wrong_cell_fails_compile_naming_it(cli, tmp_path):
     (bad / "fake_xor.py").write_text(FAKE_XOR)
     out_json = tmp_path / "x.json"
     rc, out, err = cli("compile", spec, "--cells", bad, "-o", out_json)
-    assert rc == 1 and out_json.exists()  # written for inspection
+    # the design's own kinematic proof finds z wrong at a=1 b=1: the design is not handed out
+    assert rc == 1 and not out_json.exists()
     assert "fake_xor" in err and "inputs A=1 B=1" in err and "computes its type XOR" in err
+    assert "PROOF FAILED: kinematic proof" in err and "a=1 b=1" in err and "NOT written" in err
+    # --no-prove writes it for inspection (the cell's own check still fails compile)
+    rc, out, err = cli("compile", spec, "--cells", bad, "-o", out_json, "--no-prove")
+    assert rc == 1 and out_json.exists() and "PROOF FAILED" not in err
     # control: a correct user XOR passes the same proof
     good = tmp_path / "good"
     good.mkdir()

@@ -1,18 +1,31 @@
 """The design JSON back end: Design <-> JSON (validated against the shipped schema; the
-mechanism geometry of every cell and the top-level ``mechanism``), written atomically."""
+mechanism geometry of every cell and the top-level ``mechanism``), written atomically.
+
+A design file is plain JSON in a compact layout: the top-level keys and the records of the big
+lists and maps (cells, nets, the mechanism's parts) one per line, each record without
+whitespace. A 10-input random spec's design is about 2.6 times smaller that way than indented,
+and still diffs line by line (benchmarks/design_file.py). Reading validates against the schema
+with jsonschema-rs, and only on a failure with the pure-Python jsonschema, whose error path and
+message the user sees: the same verdict and message as before, a hundred times faster on a
+large design. Any valid JSON layout loads, indented files of earlier versions included, and a
+design written as ``NAME.json.gz`` is the same text gzip-compressed (9 times smaller again).
+"""
 
 from __future__ import annotations
 
+import gzip
 import json
 import math
 import os
 import tempfile
+import zlib
 from dataclasses import asdict, fields
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
 
 import jsonschema
+import jsonschema_rs
 
 from mechc import FORMAT_VERSION, __version__
 from mechc.errors import SpecError, UsageError, read_input
@@ -56,7 +69,6 @@ def design_to_json(d: Design, timings: bool = False) -> dict:
         "stats": stats,
     }
     if mech is not None:
-
         out["mechanism"] = mechanism_json(mech)
     if getattr(d, "sequential", None) is not None:
         out["sequential"] = d.sequential.to_json()
@@ -72,8 +84,61 @@ def _net_key(name: str):
     return (0, 0, name)
 
 
+#: The first bytes of a gzip file: a design may be written compressed (``-o NAME.json.gz``).
+GZIP_MAGIC = b"\x1f\x8b"
+
+
+def design_bytes(text: str, path: str | Path) -> str | bytes:
+    """What a design file at ``path`` holds: the JSON text, or for a name ending in ``.gz``
+    that text gzip-compressed (with no time stamp, so the bytes stay reproducible)."""
+    if str(path).lower().endswith(".gz"):
+        return gzip.compress(text.encode("utf-8"), mtime=0)
+    return text
+
+
 def dumps(obj: dict) -> str:
+    """Indented JSON: small documents a person reads (proof reports)."""
     return json.dumps(obj, indent=2, ensure_ascii=False) + "\n"
+
+
+#: A container below the top level is written on one line unless its one-line text is longer
+#: (a short one, such as the list of inputs, also directly under the top level).
+ONE_LINE_MAX = 100_000
+SHORT = 120
+
+
+def dumps_design(obj: dict) -> str:
+    """A design in the compact layout: the top level and its lists and maps one entry per
+    line, short ones and anything deeper on one line without spaces unless it is over
+    ONE_LINE_MAX characters (the mechanism's rods, say), which is then broken the same way.
+    Deterministic: two runs on one spec give the same bytes."""
+    out: list[str] = []
+    _write(obj, 0, out)
+    return "".join(out) + "\n"
+
+
+def _compact(o) -> str:
+    return json.dumps(o, ensure_ascii=False, separators=(",", ":"))
+
+
+def _write(o, depth: int, out: list[str]) -> None:
+    if isinstance(o, (dict, list)) and o:
+        if depth >= 1:
+            text = _compact(o)
+            if len(text) <= (ONE_LINE_MAX if depth >= 2 else SHORT):
+                out.append(text)
+                return
+        is_dict = isinstance(o, dict)
+        out.append("{\n" if is_dict else "[\n")
+        items = list(o.items()) if is_dict else list(enumerate(o))
+        pad = "  " * (depth + 1)
+        for n, (k, v) in enumerate(items):
+            out.append(pad + _compact(k) + ": " if is_dict else pad)
+            _write(v, depth + 1, out)
+            out.append(",\n" if n + 1 < len(items) else "\n")
+        out.append("  " * depth + ("}" if is_dict else "]"))
+    else:
+        out.append(_compact(o))
 
 
 def check_writable(path: str | Path) -> None:
@@ -129,9 +194,27 @@ def schema() -> dict:
     return json.loads(resources.files("mechc").joinpath("schema/mechc.schema.json").read_text())
 
 
+@lru_cache(maxsize=1)
+def fast_validator():
+    """The schema compiled by jsonschema-rs (Draft 2020-12, as the schema declares)."""
+    return jsonschema_rs.Draft202012Validator(schema())
+
+
 def validate(obj: dict, where: str) -> None:
+    """Against the schema: jsonschema-rs decides (0.2 s where jsonschema takes 19 s on an 80 MB
+    design); a design it rejects is validated again by jsonschema for the message, which
+    names the first wrong place by its path."""
+    try:
+        if fast_validator().is_valid(obj):
+            return
+    except ValueError:  # a value jsonschema-rs does not take (a numpy scalar): jsonschema decides
+        pass
     v = jsonschema.Draft202012Validator(schema())
     errors = sorted(v.iter_errors(obj), key=lambda e: list(e.absolute_path))
+    if not errors:  # the two validators disagree: jsonschema-rs's own message, never a pass
+        e = next(iter(fast_validator().iter_errors(obj)))
+        loc = "/".join(str(p) for p in e.instance_path) or "(top level)"
+        raise UsageError(f"{where}: not a valid mechc design at {loc}: {e.message}")
     if errors:
         e = errors[0]
         loc = "/".join(str(p) for p in e.absolute_path) or "(top level)"
@@ -150,6 +233,11 @@ DECODE_ERRORS = (KeyError, IndexError, TypeError, ValueError, AttributeError)
 def load_design_json(path: str | Path) -> dict:
     p = Path(path)
     data = read_input(p, "a design file (.json)", "design")
+    if data[:2] == GZIP_MAGIC:  # a design written as NAME.json.gz
+        try:
+            data = gzip.decompress(data)
+        except (OSError, EOFError, zlib.error) as e:
+            raise UsageError(f"{p}: cannot read design: a damaged gzip file ({e})") from None
     try:
         obj = json.loads(data)  # bytes: UTF-8, UTF-16 or UTF-32, as RFC 8259 allows
     except json.JSONDecodeError as e:
@@ -193,7 +281,10 @@ def check_cell_types(obj: dict, where: str) -> None:
 
 def check_numbers(obj, where: str) -> None:
     """Every number finite and within MAX_MAGNITUDE. Python's json reads NaN, Infinity and
-    1e400 (as inf), and a JSON schema lets NaN through every minimum/maximum."""
+    1e400 (as inf), and a JSON schema lets NaN through every minimum/maximum. A quick walk
+    decides (0.3 s on a 4 MB design); only a design that fails is walked again for the path."""
+    if not has_bad_number(obj):
+        return
     todo: list[tuple[object, tuple]] = [(obj, ())]
     while todo:
         o, path = todo.pop()
@@ -206,6 +297,29 @@ def check_numbers(obj, where: str) -> None:
             loc = "/".join(str(k) for k in path) or "(top level)"
             raise UsageError(f"{where}: not a valid mechc design at {loc}: {o} is not a finite "
                              f"number of magnitude at most {MAX_MAGNITUDE:g}")
+
+
+def has_bad_number(obj) -> bool:
+    """Whether any number in ``obj`` is NaN, infinite or of magnitude over MAX_MAGNITUDE
+    (containers only on the stack, no paths: four times faster than the walk with paths)."""
+    m = MAX_MAGNITUDE
+    stack = [obj]
+    while stack:
+        o = stack.pop()
+        for v in (o.values() if isinstance(o, dict) else o):
+            t = type(v)
+            if t is float:
+                if not -m <= v <= m:  # NaN fails both comparisons
+                    return True
+            elif t is int:
+                if v > m or v < -m:
+                    return True
+            elif t is dict or t is list:
+                stack.append(v)
+            elif t is not str and t is not bool and isinstance(v, (int, float)):
+                if not -m <= float(v) <= m:  # a numpy scalar, in a design not yet written
+                    return True
+    return False
 
 
 def check_references(obj: dict, where: str) -> None:
@@ -286,7 +400,9 @@ def check_references(obj: dict, where: str) -> None:
             raise bad(("mechanism", "outputs", name), f"owner {owner!r} has no terminal {pin!r}")
 
 
-def design_from_json(obj: dict, where: str = "<json>") -> Design:
+def design_from_json(obj: dict, where: str = "<json>", mechanism: bool = True) -> Design:
+    """The Design a checked JSON holds; ``mechanism=False`` leaves the geometry unread (a logic
+    proof needs only the netlist; the whole file was still checked on loading)."""
     try:
         spec = _spec_from_json(obj["spec"], where)
     except DECODE_ERRORS as e:
@@ -305,8 +421,7 @@ def design_from_json(obj: dict, where: str = "<json>") -> Design:
         except DECODE_ERRORS as e:
             raise UsageError(f"{where}: inconsistent layout: {_why(e)}") from None
     mech = None
-    if obj.get("mechanism"):
-
+    if mechanism and obj.get("mechanism"):
         try:
             mech = mechanism_from_json(obj["mechanism"], obj["cells"])
         except DECODE_ERRORS as e:

@@ -30,6 +30,13 @@ from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import evaluate, signal_of
 
 SCALE_BAR_MM = 50.0
+#: The widest a drawing is shown by default (px): one screen. A larger mechanism is shown
+#: smaller, and its text drawn larger by as much, so that it reads at these sizes (px as shown).
+DEFAULT_WIDTH = 1600.0
+IO_PX = 18.0  # input and output labels, at the edges
+LABEL_PX = 12.0  # cell and net names, legend
+TITLE_PX = 16.0
+NET_LABELS_DOWN_TO = 0.5  # nets are named on drawings shown at least this fraction of scale
 
 # (fill, stroke, group opacity) per drawing class
 _INPUT = ("#9ecae1", "#08519c", 0.95)
@@ -53,9 +60,11 @@ class Drawing:
     size_mm: tuple[float, float] = (0.0, 0.0)
 
 
-def draw_svg(design, state: dict[str, int], scale: float = 2.0, labels: bool = True) -> str:
-    """SVG text of ``design`` with its primary inputs at ``state`` (missing inputs are off)."""
-    return render(design, state, scale, labels).svg
+def draw_svg(design, state: dict[str, int], scale: float = 2.0, labels: bool = True,
+             width: float | None = DEFAULT_WIDTH) -> str:
+    """SVG text of ``design`` with its primary inputs at ``state`` (missing inputs are off),
+    shown at most ``width`` px wide (None: its natural size, ``scale`` px per mm)."""
+    return render(design, state, scale, labels, width=width).svg
 
 
 # ---- state --------------------------------------------------------------------------------------
@@ -256,54 +265,13 @@ def _shapes(mech, mover: _Mover, conn: dict[str, set[int]]):
     return shapes, boxes
 
 
-def _labels(design, mover: _Mover, outs: dict[str, float], state: dict[str, int],
-            boxes, conn: dict[str, set[int]]) -> list[_Label]:
-    """Inputs at their sliders, outputs at their terminals, cells at their boxes, nets at
-    their fan-out bars; each knows where it sits at the design pose and how far it can move."""
+def _labels(design, mover: _Mover, boxes, conn: dict[str, set[int]]) -> list[_Label]:
+    """Cells at their boxes, nets at their fan-out bars; each knows where it sits at the
+    design pose and how far it can move. Inputs and outputs are labelled at the drawing's
+    edges (``_edge_labels``)."""
     mech = design.mechanism
     labels: list[_Label] = []
-    for name, part in mech.inputs.items():
-        t = part.terminals[name]
-        b = part.body(t.body)
-        x_home = min(p[0] for p in b.outline[0])
-        x, _ = mover.pt(b.id, (x_home, t.off[1]))
-        on = state[name] == 1
-        labels.append(_Label(f"{name} {'on' if on else 'off'}", (x, t.off[1]), "end",
-                             "li1" if on else "li0", dx=-4, home=(x_home, t.off[1]),
-                             sweep=_sweep(b, mech.ctx.stroke), widest=f"{name} off"))
     w = mech.ctx.bar
-    for name, (owner, pin) in mech.outputs.items():
-        t = mech.owner_part(owner).terminals[pin]
-        sig = outs.get(name, float("nan"))
-        # right of the output body's tip on the terminal's row (connectors excepted)
-        b = mover.bodies[t.body]
-        mid = t.design_point
-        tip = max([mid] + [p for i, poly in enumerate(b.outline) if i not in conn.get(b.id, ())
-                           for p in poly if abs(p[1] - mid[1]) < mech.ctx.bar])
-        x, _ = mover.pt(b.id, tip)
-        # and clear of the fixed ends of its springs and stops on that row
-        part = mech.owner_part(owner)
-        stops = [joint_kind(j.kind).ground_point(j) for j in part.joints]
-        fixed = [p[0] for p in stops if p is not None and abs(p[1] - mid[1]) < w]
-        fixed += [p[0] for sp in part.springs for who, p in ((sp.a, sp.pa), (sp.b, sp.pb))
-                  if who == GROUND and abs(p[1] - mid[1]) < w]
-        if fixed and max(fixed) > tip[0]:
-            tip = (max(fixed), tip[1])
-            x = max(x, tip[0])
-        if sig != sig:
-            text, cls = f"{name} = ? (not solved)", "lbad"
-        else:
-            on = sig > 0.5
-            text, cls = f"{name} = {int(on)} ({'on' if on else 'off'})", "lo1" if on else "lo0"
-        if owner.startswith("in:"):  # an output wired straight to an input: under its name
-            x_home = min(p[0] for p in b.outline[0])
-            x, _ = mover.pt(b.id, (x_home, t.off[1]))
-            labels.append(_Label(text, (x, t.off[1]), "end", cls, dx=-4, dy=15,
-                                 home=(x_home, t.off[1]), sweep=_sweep(b, mech.ctx.stroke),
-                                 widest=f"{name} = 0 (off)"))
-            continue
-        labels.append(_Label(text, (x, t.off[1]), "start", cls, dx=5, home=(tip[0], t.off[1]),
-                             sweep=_sweep(b, mech.ctx.stroke), widest=f"{name} = 0 (off)"))
     for cid, (x0, _y0, _x1, y1) in boxes.items():
         c = design.netlist.cells[cid]
         labels.append(_Label(f"{cid} {c.type}", (x0, y1), "start", "lc", dx=-2, dy=-4))
@@ -322,6 +290,66 @@ def _labels(design, mover: _Mover, outs: dict[str, float], state: dict[str, int]
                              home=(float(xb), top + w * 0.2),
                              sweep=_sweep(mover.bodies[bid], mech.ctx.stroke)))
     return labels
+
+
+@dataclass
+class _EdgeLabel:
+    """An input's or output's label in the column at the drawing's left or right edge, on its
+    terminal's row, with a leader line to the part it names."""
+
+    text: str
+    cls: str
+    side: str  # "left" (inputs) or "right" (outputs)
+    row: float  # world y of the terminal's row (design pose: the same in every state)
+    to: Point  # world point the leader line ends at (the part, at this state's pose)
+    widest: str  # the longest text this label takes in any state
+    y: float = 0.0  # px baseline, once placed
+
+
+def _edge_labels(design, mover: _Mover, outs: dict[str, float], state: dict[str, int],
+                 conn: dict[str, set[int]]) -> list[_EdgeLabel]:
+    """Every input (left edge) and output (right edge) with its value in this state."""
+    mech = design.mechanism
+    out: list[_EdgeLabel] = []
+    for name, part in mech.inputs.items():
+        t = part.terminals[name]
+        b = part.body(t.body)
+        x_home = min(p[0] for p in b.outline[0])
+        on = state[name] == 1
+        out.append(_EdgeLabel(f"{name} {'on' if on else 'off'}", "li1" if on else "li0", "left",
+                              t.off[1], mover.pt(b.id, (x_home, t.off[1])), f"{name} off"))
+    for name, (owner, pin) in mech.outputs.items():
+        t = mech.owner_part(owner).terminals[pin]
+        sig = outs.get(name, float("nan"))
+        if sig != sig:
+            text, cls = f"{name} = ? (not solved)", "lbad"
+        else:
+            on = sig > 0.5
+            text, cls = f"{name} = {int(on)} ({'on' if on else 'off'})", "lo1" if on else "lo0"
+        b = mover.bodies[t.body]
+        mid = t.design_point
+        # the output body's tip on the terminal's row (not the fan-out bars nets add to it)
+        tip = max([mid] + [p for i, poly in enumerate(b.outline) if i not in conn.get(b.id, ())
+                           for p in poly if abs(p[1] - mid[1]) < mech.ctx.bar])
+        out.append(_EdgeLabel(text, cls, "right", t.off[1], mover.pt(b.id, tip),
+                              f"{name} = ? (not solved)"))
+    return out
+
+
+def _stack(rows: list[float], gap: float) -> list[float]:
+    """Baselines for labels wanted at ``rows`` (px, any order): each as near its row as the
+    ones before allow, at least ``gap`` apart, the run centred on the rows it serves."""
+    order = sorted(range(len(rows)), key=lambda i: rows[i])
+    ys = [rows[i] for i in order]
+    for k in range(1, len(ys)):
+        ys[k] = max(ys[k], ys[k - 1] + gap)
+    if ys:  # pull the whole run back up by half of what it was pushed down
+        shift = (sum(ys) - sum(rows[i] for i in order)) / len(ys)
+        ys = [y - shift for y in ys]
+    out = [0.0] * len(rows)
+    for k, i in enumerate(order):
+        out[i] = ys[k]
+    return out
 
 
 def _reach(mech) -> list[Point]:
@@ -381,22 +409,25 @@ def _text_w(text: str, size: float, bold: bool = False) -> float:
 
 
 def render(design, state: dict[str, int], scale: float = 2.0, labels: bool = True,
-           library=None) -> Drawing:
+           library=None, width: float | None = DEFAULT_WIDTH) -> Drawing:
     """Pose the mechanism in ``state`` and draw it; see :func:`draw_svg`. ``library``: the
-    cell library the design was compiled with (default: the standard one)."""
+    cell library the design was compiled with (default: the standard one). ``width``: the
+    widest the drawing is shown (px; None: its natural size, ``scale`` px per mm); the text
+    is sized for the size it is shown at."""
     if design.mechanism is None:
         raise UsageError("this design has no mechanism geometry (compiled by an older mechc?); "
                          "recompile the spec")
     if not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
         raise UsageError(f"--scale must be a positive number of px per mm, got {scale}")
+    if width is not None and not (math.isfinite(width) and width >= 200):
+        raise UsageError(f"--width must be at least 200 px, got {width}")
     inputs = list(design.netlist.inputs)
     state = _check_state(state, inputs)
     mover, outs = _pose(design, state, library)
     mech = design.mechanism
     conn = _connector_polys(mech)
     shapes, boxes = _shapes(mech, mover, conn)
-    labs = _labels(design, mover, outs, state, boxes, conn) if labels else []
-    S, w = mech.ctx.stroke, mech.ctx.bar
+    edge = _edge_labels(design, mover, outs, state, conn) if labels else []
 
     # The frame depends on the design, not on the state (where it can), so that drawings of
     # two states overlay exactly: every slider's outline one stroke either way, every lever's
@@ -405,33 +436,102 @@ def render(design, state: dict[str, int], scale: float = 2.0, labels: bool = Tru
         p for b in boxes.values() for p in ((b[0], b[1]), (b[2], b[3]))]
     X0, X1 = min(p[0] for p in pts), max(p[0] for p in pts)
     Y0, Y1 = min(p[1] for p in pts), max(p[1] for p in pts)
-    fs = min(14.0, max(9.0, 0.8 * w * scale))  # label font (px)
-    fs_title = fs + 3
     unsolved = sorted(mover.unsolved)
-    title = _title(design, state, outs, S, scale)
+    title = _title(design, state, outs, mech.ctx.stroke, scale)
+    # Text is sized in px as shown: a drawing wider than ``width`` is shown smaller, so its
+    # text is drawn larger in its own units, by the factor it will be shrunk (found in a few
+    # rounds, since the margins the text needs widen the drawing)
+    k = 1.0
+    for _ in range(6):
+        lay = _layout(design, mover, boxes, conn, edge, labels, title, bool(unsolved), shapes,
+                      (X0, X1, Y0, Y1), scale, k)
+        fit = 1.0 if width is None or lay.W * k <= width else width / lay.W
+        if abs(fit - k) <= 0.01 * k:
+            break
+        k = fit
+    show = min(1.0, fit)
+    return Drawing(_svg(lay, shapes, boxes, edge, lay.title, unsolved, scale, show,
+                        mech.ctx.bar),
+                   outs, unsolved, (X1 - X0, Y1 - Y0))
+
+
+@dataclass
+class _Layout:
+    """Where everything goes, in the drawing's own units (``scale`` px per mm)."""
+
+    W: float
+    H: float
+    f: _Frame
+    fs: float  # cell and net labels, legend
+    fs_io: float  # inputs and outputs
+    fs_title: float
+    k: float  # the display factor the text was sized for
+    title: str
+    labs: list
+    legend: str
+    legend_y: float  # the scale bar's and the legend's first baseline
+    io_x: tuple[float, float]  # the left column's right end, the right column's left end
+
+
+def _layout(design, mover: _Mover, boxes, conn, edge: list[_EdgeLabel], labels: bool,
+            title: str, warn: bool, shapes, ext, scale: float, k: float) -> _Layout:
+    X0, X1, Y0, Y1 = ext
+    fs = LABEL_PX / k
+    fs_io = IO_PX / k
+    fs_title = TITLE_PX / k
+    labs = _labels(design, mover, boxes, conn) if labels else []
+    if k < NET_LABELS_DOWN_TO:  # shown this small, net names would bury the cells' names
+        labs = [lb for lb in labs if lb.cls != "ln"]
     boxes_px = _place_labels(labs, fs, lambda x: (x - X0) * scale, lambda y: (Y1 - y) * scale)
-    left = max([10.0] + [10.0 - b[0] for b in boxes_px])
-    right = max([10.0] + [b[2] + 10.0 - (X1 - X0) * scale for b in boxes_px])
-    above = max([10.0] + [6.0 - b[1] for b in boxes_px])
-    top = fs_title * (2.8 if unsolved else 1.8) + above
+    gap = 1.5 * fs_io  # between the mechanism and the label columns (leader lines)
+    lw = [_text_w(e.widest, fs_io, bold=True) for e in edge if e.side == "left"]
+    rw = [_text_w(e.widest, fs_io, bold=True) for e in edge if e.side == "right"]
+    left = max([10.0 / k] + [10.0 / k - b[0] for b in boxes_px]
+               + [10.0 / k + w + gap for w in lw])
+    right = max([10.0 / k] + [b[2] + 10.0 / k - (X1 - X0) * scale for b in boxes_px]
+                + [10.0 / k + w + gap for w in rw])
+    above = max([10.0 / k] + [6.0 / k - b[1] for b in boxes_px])
+    top = fs_title * (2.8 if warn else 1.8) + above
+    # the io columns: baselines on their rows, spread where rows are closer than a line
+    for side in ("left", "right"):
+        mine = [e for e in edge if e.side == side]
+        ys = _stack([top + (Y1 - e.row) * scale + 0.35 * fs_io for e in mine], 1.25 * fs_io)
+        for e, y in zip(mine, ys):
+            e.y = y
+    above_io = max([0.0] + [top - (e.y - fs_io) for e in edge])
+    top += above_io
+    for e in edge:
+        e.y += above_io
     W = (X1 - X0) * scale + left + right
-    W = max(W, _text_w(title, fs_title, bold=True) + 20, SCALE_BAR_MM * scale + 300)
-    legend, rows = _legend(10.0 + SCALE_BAR_MM * scale + 40, fs, sorted(
+    W = max(W, SCALE_BAR_MM * scale + 300 / k)
+    if _text_w(title, fs_title, bold=True) + 20 / k > W:  # a long state: it is at the edges
+        title = _short_title(title)
+    W = max(W, _text_w(title, fs_title, bold=True) + 20 / k)
+    legend, rows = _legend(10.0 / k + SCALE_BAR_MM * scale + 40 / k, fs, sorted(
         {s.cls for s in shapes if s.kind == "body"}), any(s.kind == "spring" for s in shapes),
-        W - 10)
-    bottom = 2.4 * fs + 1.6 * fs * rows + 16
+        W - 10 / k, k)
+    below_io = max([0.0] + [e.y + 0.4 * fs_io - (top + (Y1 - Y0) * scale) for e in edge])
+    bottom = 2.4 * fs + 1.6 * fs * rows + 16 / k + below_io
     H = (Y1 - Y0) * scale + top + bottom
-
     f = _Frame(X0, Y1, scale, left, top)
-    sym = max(0.9 * w * scale, 8.0)  # symbol size (px): pivots, hatches
-    pin_r = max(0.2 * w * scale, 2.0)
-    sw = max(0.12 * scale, 0.8)  # outline stroke (px)
+    legend_y = top + (Y1 - Y0) * scale + below_io + 1.4 * fs + 8 / k
+    return _Layout(W, H, f, fs, fs_io, fs_title, k, title, labs, legend, legend_y,
+                   (left - gap, left + (X1 - X0) * scale + gap))
 
+
+def _svg(lay: _Layout, shapes, boxes, edge: list[_EdgeLabel], title: str, unsolved: list[str],
+         scale: float, show: float, bar: float) -> str:
+    """The SVG text of a laid-out drawing, shown at ``show`` times its own size."""
+    W, H, f, fs, k = lay.W, lay.H, lay.f, lay.fs, lay.k
+    sym = max(0.9 * bar * scale, 8.0 / k)  # symbol size: pivots, hatches
+    pin_r = max(0.2 * bar * scale, 2.0 / k)
+    sw = max(0.12 * scale, 0.8 / k)  # outline stroke
     out: list[str] = [
-        f'<svg xmlns="http://www.w3.org/2000/svg" width="{W:.0f}" height="{H:.0f}" '
-        f'viewBox="0 0 {W:.0f} {H:.0f}" font-family="DejaVu Sans, Arial, sans-serif">',
+        f'<svg xmlns="http://www.w3.org/2000/svg" width="{W * show:.0f}" '
+        f'height="{H * show:.0f}" viewBox="0 0 {W:.0f} {H:.0f}" '
+        'font-family="DejaVu Sans, Arial, sans-serif">',
         f"<title>{escape(title)}</title>",
-        "<style>" + _css(sw, fs, fs_title) + "</style>",
+        "<style>" + _css(sw, fs, lay.fs_title, k, lay.fs_io) + "</style>",
         f'<rect width="{W:.0f}" height="{H:.0f}" fill="white"/>',
         '<g class="box">',  # faint cell boxes
     ]
@@ -442,24 +542,38 @@ def render(design, state: dict[str, int], scale: float = 2.0, labels: bool = Tru
     out += _svg_bodies(shapes, f, pin_r)
     out += _svg_mechanics(shapes, f, sym, pin_r)
     out.append('<g class="lbl">')
-    for lb in labs:
+    for lb in lay.labs:
         attrs = (f'x="{f.X(lb.at[0]) + lb.dx:.1f}" y="{f.Y(lb.at[1]) + lb.dy:.1f}" '
                  f'text-anchor="{lb.anchor}"')
         # a white halo under each label (paint-order is not understood by every renderer)
         out.append(f'<text class="{lb.cls} halo" {attrs}>{escape(lb.text)}</text>'
                    f'<text class="{lb.cls}" {attrs}>{escape(lb.text)}</text>')
     out.append("</g>")
+    out.append('<g class="io">')  # inputs at the left edge, outputs at the right
+    xl, xr = lay.io_x
+    for e in edge:
+        px, py = f.X(e.to[0]), f.Y(e.to[1])
+        x = xl if e.side == "left" else xr
+        end = x + (0.3 if e.side == "left" else -0.3) * lay.fs_io
+        out.append(f'<path class="ld" d="M{end:.1f},{e.y - 0.35 * lay.fs_io:.1f}'
+                   f'L{px:.1f},{py:.1f}"/>')
+        out.append(f'<text class="{e.cls} io{e.side[0]}" x="{x:.1f}" y="{e.y:.1f}" '
+                   f'text-anchor="{"end" if e.side == "left" else "start"}">'
+                   f"{escape(e.text)}</text>")
+    out.append("</g>")
     # title, warning, scale bar, legend
-    out.append(f'<text class="tt" x="10" y="{fs_title + 4:.1f}">{escape(title)}</text>')
+    out.append(f'<text class="tt" x="{10 / k:.1f}" y="{lay.fs_title + 4 / k:.1f}">'
+               f"{escape(title)}</text>")
     if unsolved:
         msg = (f"NOT SOLVED in this state, drawn dashed red at the design pose: "
                f"{', '.join(unsolved[:8])}{' ...' if len(unsolved) > 8 else ''}")
-        out.append(f'<text class="lbad" x="10" y="{2.2 * fs_title + 4:.1f}">{escape(msg)}</text>')
-    yb = H - bottom + 1.4 * fs + 8
-    out.append(_scale_bar(10.0, yb, scale, fs))
-    out.append(f'<g transform="translate(0 {yb:.1f})">{legend}</g>')
+        out.append(f'<text class="lbad" x="{10 / k:.1f}" y="{2.2 * lay.fs_title + 4 / k:.1f}">'
+                   f"{escape(msg)}</text>")
+    yb = lay.legend_y
+    out.append(_scale_bar(10.0 / k, yb, scale, fs, k))
+    out.append(f'<g transform="translate(0 {yb:.1f})">{lay.legend}</g>')
     out.append("</svg>")
-    return Drawing("\n".join(out) + "\n", outs, unsolved, (X1 - X0, Y1 - Y0))
+    return "\n".join(out) + "\n"
 
 
 @dataclass(frozen=True)
@@ -543,8 +657,18 @@ def _title(design, state, outs, S, scale) -> str:
             f"{scale:g} px/mm")
 
 
-def _css(sw: float, fs: float, ft: float) -> str:
-    rules = [".box rect{fill:#f7f7f7;stroke:#bdbdbd;stroke-width:0.8;stroke-dasharray:4 3}",
+def _short_title(title: str) -> str:
+    """The title without its list of input and output values (they are at the edges)."""
+    parts = title.split("  |  ")
+    return "  |  ".join([parts[0], "input and output values at the edges"] + parts[2:])
+
+
+def _css(sw: float, fs: float, ft: float, k: float = 1.0, fio: float = 16.0) -> str:
+    """The style, with every width and font in the drawing's units (``k``: the display
+    factor, so that lines and text keep their width in px as shown)."""
+    u = 1.0 / k
+    rules = [f".box rect{{fill:#f7f7f7;stroke:#969696;stroke-width:{0.8 * u:.2f};"
+             f"stroke-dasharray:{4 * u:.1f} {3 * u:.1f}}}",
              f".o{{fill:none;stroke-width:{2 * sw:.2f};stroke-linejoin:round}}",
              ".f{stroke:none}"]
     classes = {"in": _INPUT, "cn": _CONNECTOR, "bad": ("#fee0d2", _BAD, 0.7)}
@@ -554,18 +678,22 @@ def _css(sw: float, fs: float, ft: float) -> str:
     rules += [
         ".bad .o{stroke-dasharray:5 3}",
         ".slo{stroke:#252525;stroke-linecap:round}.sli{stroke:white;stroke-linecap:round}",
-        f".sp{{fill:none;stroke:{_SPRING};stroke-width:1.2;stroke-linejoin:round}}",
-        f".rod{{stroke:{_CONNECTOR[1]};stroke-width:1.6}}",
-        f".rp{{fill:white;stroke:{_CONNECTOR[1]};stroke-width:1.2}}",
-        ".pin{fill:#252525}.pv{fill:white;stroke:#252525;stroke-width:1.4}",
-        f".gd{{fill:none;stroke:{_GROUND};stroke-width:1}}",
-        f".gb{{fill:none;stroke:{_GROUND};stroke-width:1.8}}",
+        f".sp{{fill:none;stroke:{_SPRING};stroke-width:{1.2 * u:.2f};stroke-linejoin:round}}",
+        f".rod{{stroke:{_CONNECTOR[1]};stroke-width:{1.6 * u:.2f}}}",
+        f".rp{{fill:white;stroke:{_CONNECTOR[1]};stroke-width:{1.2 * u:.2f}}}",
+        f".pin{{fill:#252525}}.pv{{fill:white;stroke:#252525;stroke-width:{1.4 * u:.2f}}}",
+        f".gd{{fill:none;stroke:{_GROUND};stroke-width:{u:.2f}}}",
+        f".gb{{fill:none;stroke:{_GROUND};stroke-width:{1.8 * u:.2f}}}",
         f"text{{font-size:{fs:.1f}px;fill:#252525}}",
-        ".lbl .halo{fill:white;stroke:white;stroke-width:3px;stroke-linejoin:round}",
+        f".lbl .halo{{fill:white;stroke:white;stroke-width:{3 * u:.2f}px;stroke-linejoin:round}}",
         f".tt{{font-size:{ft:.1f}px;font-weight:bold}}",
+        f".io text{{font-size:{fio:.1f}px}}",
+        f".ld{{fill:none;stroke:#969696;stroke-width:{0.8 * u:.2f};"
+        f"stroke-dasharray:{2 * u:.1f} {2 * u:.1f}}}",
         ".lc{fill:#525252}.ln{fill:#54278f;font-style:italic}",
-        ".li0{fill:#08519c}.li1{fill:#08519c;font-weight:bold}",
-        ".lo0{fill:#525252}.lo1{fill:#006d2c;font-weight:bold}",
+        ".li0{fill:#08519c;font-weight:bold}.li1{fill:#08519c;font-weight:bold;"
+        "text-decoration:underline}",
+        ".lo0{fill:#252525;font-weight:bold}.lo1{fill:#006d2c;font-weight:bold}",
         f".lbad{{fill:{_BAD};font-weight:bold}}",
     ]
     return "".join(rules)
@@ -615,20 +743,21 @@ def _ground(x: float, y: float, into: Point | None, size: float, base: float = 0
             f'{"".join(hatch)}"/>')
 
 
-def _scale_bar(x: float, y: float, scale: float, fs: float) -> str:
+def _scale_bar(x: float, y: float, scale: float, fs: float, k: float = 1.0) -> str:
     """A 50 mm bar with 10 mm ticks; its ``x2 - x1`` is exactly 50 mm at the drawing's scale."""
     L = SCALE_BAR_MM * scale
-    ticks = "".join(f"M{x + i * 10 * scale:.2f},{y - 4:.1f}v8" for i in range(6))
+    u = 1.0 / k
+    ticks = "".join(f"M{x + i * 10 * scale:.2f},{y - 4 * u:.1f}v{8 * u:.1f}" for i in range(6))
     return (f'<g class="scale"><line id="scalebar" x1="{x:.2f}" y1="{y:.1f}" x2="{x + L:.2f}" '
-            f'y2="{y:.1f}" stroke="black" stroke-width="2"/>'
-            f'<path d="{ticks}" stroke="black" stroke-width="1"/>'
-            f'<text x="{x:.1f}" y="{y + fs + 6:.1f}">0</text>'
-            f'<text x="{x + L:.1f}" y="{y + fs + 6:.1f}" text-anchor="middle">'
+            f'y2="{y:.1f}" stroke="black" stroke-width="{2 * u:.2f}"/>'
+            f'<path d="{ticks}" stroke="black" stroke-width="{u:.2f}"/>'
+            f'<text x="{x:.1f}" y="{y + fs + 6 * u:.1f}">0</text>'
+            f'<text x="{x + L:.1f}" y="{y + fs + 6 * u:.1f}" text-anchor="middle">'
             f"{SCALE_BAR_MM:g} mm</text></g>")
 
 
 def _legend(x: float, fs: float, classes: list[str], springs: bool,
-            max_x: float) -> tuple[str, int]:
+            max_x: float, k: float = 1.0) -> tuple[str, int]:
     """Colour key from ``x`` on the baseline y = 0, wrapped into rows that end by ``max_x``;
     returns the SVG and the number of rows."""
     names = {"in": "input slider", "cn": "fan-out bar, rod", "bad": "not solved"}
@@ -638,6 +767,7 @@ def _legend(x: float, fs: float, classes: list[str], springs: bool,
     items = [(c, names[c]) for c in order if c in classes]
     items += [("spring", "spring")] if springs else []
     items += [("ground", "ground (pivot, anchor, stop)")]
+    items += [("cell", "cell: id TYPE"), ("io", "inputs left, outputs right")]
     out = ['<g class="legend">']
     cx, row = x, 0
     for key, text in items:
@@ -651,6 +781,13 @@ def _legend(x: float, fs: float, classes: list[str], springs: bool,
                 for i in range(6)) + '"/>')
         elif key == "ground":
             out.append(_ground(cx + fs * 0.8, y - fs * 0.6, (0.0, -1.0), fs * 1.2))
+        elif key == "cell":
+            out.append(f'<g class="box"><rect x="{cx:.1f}" y="{y - fs * 0.8:.1f}" '
+                       f'width="{fs * 1.6:.1f}" height="{fs:.1f}"/></g>')
+        elif key == "io":
+            out.append(f'<text x="{cx:.1f}" y="{y:.1f}" fill="#08519c" font-weight="bold">'
+                       f'A</text><text x="{cx + fs:.1f}" y="{y:.1f}" fill="#006d2c" '
+                       'font-weight="bold">Z</text>')
         else:
             box = (f'x="{cx:.1f}" y="{y - fs * 0.8:.1f}" width="{fs * 1.6:.1f}" '
                    f'height="{fs:.1f}"')

@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
+import threading
+import time
 from pathlib import Path
 
 from mechc.backends.design_json import check_writable, design_from_json, load_design_json
@@ -20,8 +23,8 @@ from mechc.passes.strength import force_ceiling
 from mechc.pipeline import CompileOptions, compile_sequential, compile_spec
 from mechc.ui import finite_float, int_at_least
 
-__all__ = ["by_type", "check_output", "compile_options", "compile_path", "load_design_or_spec",
-           "load_spec", "options_from_args"]
+__all__ = ["StageProgress", "by_type", "check_output", "compile_options", "compile_path",
+           "load_design_or_spec", "load_spec", "options_from_args"]
 
 
 def compile_options(c: argparse.ArgumentParser) -> None:
@@ -121,13 +124,79 @@ def check_forces(args: argparse.Namespace) -> None:
                 f"widens the bars, or choose another --material)")
 
 
-def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = True) -> Design:
+def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = True,
+                 stages: StageProgress | None = None) -> Design:
     """Compile a spec file in memory (``mechanism=False``: a sequential spec stops after
-    placement, all its logic proof needs)."""
+    placement, all its logic proof needs); ``stages`` shows the stages of a long compile."""
     spec = load_spec(spec_path)
     if not mechanism and getattr(spec, "kind", "") == "fsm":
         return compile_sequential(spec, options_from_args(args), mechanism=False)
-    return compile_spec(spec, options_from_args(args))
+    if stages is None:
+        return compile_spec(spec, options_from_args(args))
+    return compile_spec(spec, options_from_args(args), progress=stages.start, done=stages.end)
+
+
+class StageProgress:
+    """The stages of a long job on stderr, silent for a short one: a stage still running after
+    ``delay`` seconds is named (``compile: assemble ...``) and its seconds printed when it ends;
+    :meth:`summary` gives every stage's seconds once the whole job took ``delay`` or more."""
+
+    def __init__(self, label: str = "compile", delay: float = 2.0, stream=None,
+                 enabled: bool = True):
+        self.label, self.delay, self.enabled = label, delay, enabled
+        self.stream = stream or sys.stderr
+        self.t0 = time.perf_counter()
+        self.seconds: list[tuple[str, float]] = []
+        self._timer: threading.Timer | None = None
+        self._named = False
+        self._lock = threading.Lock()
+
+    def start(self, name: str) -> None:
+        self._cancel()
+        self._named = False
+        if self.enabled:
+            self._timer = threading.Timer(self.delay, self._name, (name,))
+            self._timer.daemon = True
+            self._timer.start()
+
+    def _name(self, name: str) -> None:
+        with self._lock:
+            self._named = True
+            self._print(f"{self.label}: {name} ...")
+
+    def end(self, name: str, seconds: float) -> None:
+        self._cancel()
+        self.seconds.append((name, seconds))
+        if self._named or seconds >= self.delay:
+            self._print(f"{self.label}: {name} {seconds:.1f} s")
+
+    def _cancel(self) -> None:
+        with self._lock:
+            if self._timer is not None:
+                self._timer.cancel()
+                self._timer = None
+
+    def _print(self, line: str) -> None:
+        if self.enabled:
+            try:
+                print(line, file=self.stream, flush=True)
+            except (OSError, ValueError):  # the stream went away (a closed pipe)
+                self.enabled = False
+
+    def close(self) -> None:
+        """Stop any pending stage line (a job that ended by an error must not print later)."""
+        self._cancel()
+
+    def total(self) -> float:
+        return time.perf_counter() - self.t0
+
+    def summary(self) -> str | None:
+        """'compile stages (s): minimise 1.2, map 0.2, ...' when the job was long, else None."""
+        if not self.seconds or self.total() < self.delay:
+            return None
+        return (f"{self.label} stages (s): "
+                + ", ".join(f"{n} {s:.2f}" for n, s in self.seconds)
+                + f"; total {self.total():.1f}")
 
 
 def check_output(out: str, what: str, inputs: list[tuple[str, str | None]]) -> None:
@@ -155,8 +224,9 @@ def by_type(d: dict) -> str:
 
 def load_design_or_spec(path: str, args: argparse.Namespace) -> Design:
     """A compiled design (.json), or a spec compiled in memory."""
-    if path.lower().endswith(".json"):
-        return design_from_json(load_design_json(path), path)
+    if path.lower().endswith((".json", ".json.gz")):  # the logic level reads no geometry
+        return design_from_json(load_design_json(path), path,
+                                mechanism=getattr(args, "level", None) != "logic")
     # a logic proof of a sequential spec needs the netlist only, not the mechanism
     return compile_path(path, args, mechanism=getattr(args, "level", None) != "logic")
 

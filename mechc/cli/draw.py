@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from mechc.backends.design_json import write_atomic
-from mechc.backends.svg import parse_state, render
+from mechc.backends.svg import DEFAULT_WIDTH, parse_state, render
 from mechc.cells.sources import library_for_design
 from mechc.cli.common import check_output, compile_options, load_design_or_spec
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
@@ -29,6 +29,10 @@ def register(sub) -> None:
                    help="input values (0/1 or off/on); inputs not named are off")
     d.add_argument("--scale", type=float, default=2.0, metavar="PX_PER_MM",
                    help="pixels per millimetre (default: %(default)s)")
+    d.add_argument("--width", type=float, default=DEFAULT_WIDTH, metavar="PX",
+                   help="show the drawing at most this wide, its text sized to read at that "
+                   "size (default: %(default)g px, one screen); 0: its natural size, --scale "
+                   "px per mm")
     d.add_argument("--no-labels", action="store_true",
                    help="leave out cell, net, input and output labels")
     compile_options(d)
@@ -38,6 +42,8 @@ def register(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     if not math.isfinite(args.scale) or args.scale <= 0:
         raise UsageError(f"--scale must be a positive number of px per mm, got {args.scale:g}")
+    if args.width and not (math.isfinite(args.width) and args.width >= 200):
+        raise UsageError(f"--width must be at least 200 px (or 0), got {args.width:g}")
     out = args.output or default_output(args.design)
     check_output(out, "drawing", [("input", args.design)])
     design = load_design_or_spec(args.design, args)
@@ -46,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
                          "spec with this mechc")
     state = parse_state(args.state, list(design.netlist.inputs))
     lib = library_for_design(design.cell_sources, args.cell_dirs, args.design)
-    dr = render(design, state, args.scale, not args.no_labels, lib)
+    dr = render(design, state, args.scale, not args.no_labels, lib, args.width or None)
     write_atomic(out, dr.svg)
     ins = " ".join(f"{k}={v}" for k, v in state.items())
     res = " ".join(f"{k}={int(v > 0.5) if v == v else '?'}" for k, v in dr.outputs.items())

@@ -9,7 +9,7 @@ import sys
 import traceback
 
 from mechc import __version__
-from mechc.cli import bench, cells, draw, export, new_cell, simulate, synth
+from mechc.cli import bench, cells, draw, export, new_cell, simulate, synth, view
 from mechc.cli import compile as compile_cmd
 from mechc.errors import (
     EXIT_INTERNAL,
@@ -26,6 +26,7 @@ mechanical cells (sliders, levers, springs) with their geometry, and a simulatio
   mechc simulate sorter.json                   prove it (levels: logic, kinematic, dynamic)
   mechc draw sorter.json -o sorter.svg         look at it
   mechc export sorter.json -o sorter.dxf       make it: cut sheets, parts list, 3D model
+  mechc view sorter.json -o sorter.html        watch it move (a page for any browser)
   mechc cells                                  list the cell library
 
 Exit status: 0 success, 1 a proof or design check failed, 2 bad input, 3 internal error.
@@ -70,6 +71,7 @@ def build_parser() -> argparse.ArgumentParser:
     new_cell.register(sub)
     draw.register(sub)
     export.register(sub)
+    view.register(sub)
     synth.register(sub)
     bench.register(sub)
     return p

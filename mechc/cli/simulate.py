@@ -16,6 +16,7 @@ from mechc.ir.spec import Spec
 from mechc.physics.scene import DynSettings
 from mechc.proofs import LEVELS, ProofReport, ProofSettings, prove, spec_kind
 from mechc.proofs import trace as pose_trace
+from mechc.proofs.parallel import available_cores
 from mechc.ui import Progress, finite_float
 
 
@@ -57,6 +58,15 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.add_argument("--accuracy", type=finite_float, default=None, metavar="F",
                    help="dynamic: the cheapest settings (from the measured error model) whose "
                    "output error is at most F of stroke, confirmed on the run by step halving")
+    s.add_argument("--jobs", type=int, default=None, metavar="N",
+                   help="dynamic: run the input changes (a sequential design: its walks) on N "
+                   "processes; the report is the same as with --jobs 1, case by case (default: "
+                   f"every core this process may use, here {available_cores()}; a --trace "
+                   "run stays in this process)")
+    s.add_argument("--scheduler", metavar="ADDRESS",
+                   help="dynamic: run the same cases on the Dask distributed cluster whose "
+                   "scheduler is at ADDRESS (e.g. tcp://127.0.0.1:8786; needs "
+                   "pip install 'mechc[cluster]'); the report is the serial run's")
     s.add_argument("--spec", metavar="OTHER",
                    help="prove against this spec instead of the one the design was compiled from")
     s.add_argument("--report", metavar="FILE.json", help="write the proof report as JSON")
@@ -88,6 +98,10 @@ def _check_options(args: argparse.Namespace) -> None:
             raise UsageError("--accuracy must be between 0 and 0.5 (fraction of stroke)")
         if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
             raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
+    if args.jobs is not None and args.jobs < 1:
+        raise UsageError("--jobs must be at least 1")
+    if args.scheduler is not None and args.level != "dynamic":
+        raise UsageError("--scheduler runs the cases of a dynamic proof (--level dynamic)")
     if args.report:  # before a proof that may take minutes, not after it
         check_output(args.report, "report", [("design", args.design), ("spec", args.spec)])
     if args.trace_every is not None:
@@ -139,19 +153,23 @@ def _recorder(args: argparse.Namespace, design: Design) -> pose_trace.TraceRecor
 def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: Library,
            trace: pose_trace.TraceRecorder | None = None) -> ProofReport:
     """The proof at ``args.level`` of ``design`` against ``spec`` (a ProofReport), with a
-    progress bar while a dynamic proof runs."""
+    progress bar while a kinematic or dynamic proof runs (shown after 1.5 s)."""
     settings = ProofSettings(tolerance=args.tolerance, seed=args.seed, cases=args.cases,
                              prune=args.prune, accuracy=args.accuracy, dt=args.dt,
                              iterations=args.iterations, move_time=args.move_time,
-                             trace=trace)
-    if args.level != "dynamic":
+                             trace=trace, jobs=args.jobs or available_cores(),
+                             scheduler=args.scheduler)
+    if args.level == "logic":
         return prove(design, spec, lib, args.level, settings)
-    what = "sequential dynamic" if spec_kind(spec) == "sequential" else "dynamic"
-    bar = Progress(1, f"{what} proof of {Path(args.design).name}")
+    what = ("sequential " if spec_kind(spec) == "sequential" else "") + args.level
+    where = (f" on {args.scheduler}" if args.scheduler
+             else f" on {settings.jobs} processes"
+             if args.level == "dynamic" and settings.jobs > 1 and not trace else "")
+    bar = Progress(1, f"{what} proof of {Path(args.design).name}{where}")
 
     def tick(done: int, total: int) -> None:
         bar.total = total
-        bar.update(done, "input changes")
+        bar.update(done, "input changes" if args.level == "dynamic" else "states")
 
     try:
         return prove(design, spec, lib, args.level, settings, tick)

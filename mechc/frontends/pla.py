@@ -19,6 +19,8 @@ from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, cube_table
 TYPES = {"f", "r", "fd", "fr", "dr", "fdr"}
 UNSUPPORTED = {"mv", "kiss", "phase", "pair", "symbolic", "symbolic-output", "label"}
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+#: What espresso accepts as a name: any printable token (``di<11>``, ``x[3]``, ``a.b``).
+_NAME_CHARS = re.compile(r"^[!-~]+$")
 #: ASCII digits only: str.isdigit() also accepts '²' (which int() refuses) and '٣' (which it reads).
 _WHOLE = re.compile(r"^[0-9]+$")
 
@@ -75,10 +77,10 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
                 if len(args) != count:
                     raise err(lineno, col0, f"'.{kw}' lists {len(args)} names, expected {count}")
                 for a in args:
-                    if not _NAME_OK.match(a):
+                    if not _NAME_CHARS.match(a):
                         raise err(lineno, line.find(a) + 1,
-                                  f"name {shorten(a)} is not usable as a signal name "
-                                  "(letters, digits and '_', not starting with a digit)")
+                                  f"name {shorten(a)} has a character espresso does not "
+                                  "accept in a name")
                 if len(set(args)) != len(args):
                     raise err(lineno, col0, f"duplicate name in '.{kw}'")
                 if kw == "ilb":
@@ -144,6 +146,10 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
     clash = set(inputs) & set(outputs)
     if clash:
         raise err(1, 1, f"name used for both an input and an output: {sorted(clash)[0]}")
+    safe = safe_names(inputs + outputs)
+    display = {safe[a]: a for a in inputs + outputs if safe[a] != a}
+    inputs = [safe[a] for a in inputs]
+    outputs = [safe[a] for a in outputs]
     funcs = {name: OutputSpec(name) for name in outputs}
     rest = {"f": 0, "fd": 0, "fr": DC, "fdr": DC, "r": 1, "dr": 1}[pla_type]
     for f in funcs.values():
@@ -159,11 +165,31 @@ def parse_pla(text: str, path: str = "<string>") -> Spec:
                 f.off.append(cube)
             elif ch in "2-" and "d" in pla_type:
                 f.dc.append(cube)
-    _check_on_off(path, n, funcs, terms, outputs)
-    return Spec(path, "pla", inputs, outputs, funcs)
+    _check_on_off(path, n, funcs, terms, outputs, display)
+    return Spec(path, "pla", inputs, outputs, funcs, display)
 
 
-def _check_on_off(path, n, funcs, terms, outputs) -> None:
+def safe_names(names: list[str]) -> dict[str, str]:
+    """Each name -> an identifier (letters, digits, '_', not starting with a digit), unique
+    among them: ``di<11>`` -> ``di_11``, ``x[3]`` -> ``x_3``; names already safe stay."""
+    out: dict[str, str] = {}
+    taken = {a for a in names if _NAME_OK.match(a)}
+    for a in names:
+        if _NAME_OK.match(a):
+            out[a] = a
+            continue
+        base = re.sub(r"[^A-Za-z0-9_]+", "_", a).strip("_") or "s"
+        if base[0].isdigit():
+            base = "s" + base
+        cand, k = base, 2
+        while cand in taken:
+            cand, k = f"{base}_{k}", k + 1
+        taken.add(cand)
+        out[a] = cand
+    return out
+
+
+def _check_on_off(path, n, funcs, terms, outputs, display) -> None:
     """Espresso refuses a PLA whose on-set and off-set meet; so do we, naming both lines."""
     for j, name in enumerate(outputs):
         f = funcs[name]
@@ -193,5 +219,6 @@ def _check_on_off(path, n, funcs, terms, outputs) -> None:
                     if any(d.contains(meet) for d in f.dc):
                         continue
                 raise SpecError(path, lineno, cols[j],
-                                f"output '{name}': this on-set term meets the off-set term of "
-                                f"line {lineno2} (at input {meet.to_string(n)})")
+                                f"output '{display.get(name, name)}': this on-set term meets "
+                                f"the off-set term of line {lineno2} "
+                                f"(at input {meet.to_string(n)})")

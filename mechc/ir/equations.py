@@ -57,6 +57,10 @@ class Equations:
     hazard_free: dict[str, Cover] = field(default_factory=dict)
     hazard_free_complements: dict[str, Cover] = field(default_factory=dict)
     shared_terms: int = 0  # product terms used by more than one output
+    time_limited: list[str] = field(default_factory=list)  # minimiser steps that ran out of time
+    # the per-output covers (shared afterwards) when the covers above share products across
+    # outputs: the mapper builds whichever costs fewer parts
+    alternative: Equations | None = None
 
     def expr(self, name: str, complement: bool = False) -> ex.Expr:
         cover = (self.complements if complement else self.covers)[name]
@@ -74,6 +78,11 @@ class Equations:
     @property
     def terms(self) -> int:
         return sum(c.terms for c in self.covers.values())
+
+    @property
+    def products(self) -> int:
+        """Distinct product terms over all outputs (what espresso's ``.p`` counts)."""
+        return len({c for cover in self.covers.values() for c in cover.cubes})
 
     @property
     def proven(self) -> bool:

@@ -34,6 +34,9 @@ class Spec:
     inputs: list[str]
     outputs: list[str]
     functions: dict[str, OutputSpec]
+    # safe identifier -> the name as the source file wrote it, where the two differ (PLA
+    # names such as ``di<11>``); for display only
+    display: dict[str, str] = field(default_factory=dict)
     _tables: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
     @property

@@ -17,6 +17,13 @@ from scipy import sparse
 from scipy.optimize import Bounds, LinearConstraint, milp
 
 DC_TIEBREAK_MAX_NNZ = 200_000
+#: Dominance between rows (columns) needs their pairwise product; past this many pairs the
+#: reduction stops at the essential columns (the product alone would take gigabytes).
+DOMINANCE_MAX_PAIRS = 30_000_000
+#: Covering problems up to this size are reduced on dense bit sets (``reduce_dense``).
+DENSE_MIN_ROWS = 5_000
+DENSE_MAX_COLUMNS = 20_000
+DENSE_MAX_CELLS = 400_000_000
 #: The don't-care tie-break is a nicety for hand-sized specs; past this many candidates it is
 #: skipped (it can take longer than the cover itself).
 DC_TIEBREAK_MAX_CANDIDATES = 300
@@ -96,7 +103,11 @@ def reduce_problem(A: sparse.csr_matrix, cost: np.ndarray):
             keep[ess] = False
             cols = cols[keep]
             continue
-        # row dominance: if row i's columns are a subset of row j's, row j is implied
+        # row dominance: if row i's columns are a subset of row j's, row j is implied (the
+        # pairwise product is skipped when it would be too large to hold)
+        col_deg = np.bincount(sub.indices, minlength=sub.shape[1]).astype(np.int64)
+        if int((col_deg * col_deg).sum()) > DOMINANCE_MAX_PAIRS:
+            break
         inter = (sub @ sub.T).tocoo()
         size = deg
         sub_of = (inter.data == size[inter.row]) & (inter.row != inter.col)
@@ -111,6 +122,9 @@ def reduce_problem(A: sparse.csr_matrix, cost: np.ndarray):
         # column dominance: p dominated by q if rows(p) ⊆ rows(q) and cost(q) <= cost(p)
         csize = np.diff(sub.indptr)
         empty = csize == 0
+        row_deg = np.diff(sub.tocsr().indptr).astype(np.int64)
+        if int((row_deg * row_deg).sum()) > DOMINANCE_MAX_PAIRS:
+            break
         inter = (sub.T @ sub).tocoo()
         c = cost[cols]
         dom = ((inter.data == csize[inter.row]) & (inter.row != inter.col)
@@ -245,3 +259,156 @@ def share_covers(cands: list[tuple[np.ndarray, np.ndarray]], on_rows: list[np.nd
         return None
     return [np.flatnonzero(res.x[offsets[i]:offsets[i] + len(m)] > 0.5)
             for i, (m, _v) in enumerate(cands)]
+
+
+def solve_cover(A: sparse.csr_matrix, lits: np.ndarray, n: int,
+                time_limit: float) -> tuple[np.ndarray, bool]:
+    """Fewest columns covering every row of ``A``, then the least total ``lits`` (a cost per
+    column: literals, or parts) with that count.
+
+    Returns (chosen column indices, proven). When the time limit runs out the better of the
+    solver's incumbent and the greedy cover is returned, unproven."""
+    t0 = time.perf_counter()
+    if A.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64), True
+    lits = np.asarray(lits, dtype=np.int64)
+    A = unique_rows(A)
+    g = greedy_cover(A, 1.0 + lits / (n + 1.0))
+    c = (n * len(g) + 1 + lits).astype(float)
+    forced, rows, cols = reduce_problem(A, c)
+    # the sparse reduction stops where its pairwise products grow too large: many rows left
+    # are then reduced on bit sets
+    if (len(rows) > DENSE_MIN_ROWS and len(cols) <= DENSE_MAX_COLUMNS
+            and len(rows) * len(cols) <= DENSE_MAX_CELLS):
+        f2, r2, c2 = reduce_dense(A[rows][:, cols], c[cols])
+        forced = np.union1d(forced, cols[f2]).astype(np.int64)
+        rows, cols = rows[r2], cols[c2]
+    if len(rows) == 0:
+        return forced, True
+    sub = A[rows][:, cols]
+    cover_rows = LinearConstraint(sub, 1, np.inf)
+    k = len(cols)
+    ones = np.ones(k)
+
+    def remaining():
+        return max(0.05, time_limit - (time.perf_counter() - t0))
+
+    res = milp(ones, integrality=ones, bounds=Bounds(0, 1), constraints=[cover_rows],
+               options={"time_limit": remaining()})
+    if res.x is None:
+        return g, False
+    terms = int(round(res.x.sum()))
+    proven = res.status == 0
+    if len(forced) + terms > len(g):
+        return g, False
+    res2 = milp(lits[cols].astype(float), integrality=ones, bounds=Bounds(0, 1),
+                constraints=[cover_rows, LinearConstraint(ones[None, :], terms, terms)],
+                options={"time_limit": remaining(), "mip_rel_gap": 0.0})
+    x = res2.x if res2.x is not None else res.x
+    proven = proven and res2.status == 0
+    chosen = np.sort(np.concatenate([forced, cols[x > 0.5]]))
+    return chosen, proven
+
+
+def unique_rows(A: sparse.csr_matrix) -> sparse.csr_matrix:
+    """One row per distinct column set (on-minterms inside the same cubes are one constraint);
+    rows are told apart by two random 64-bit signatures of their column sets."""
+    A = sparse.csr_matrix(A)
+    A.sum_duplicates()
+    A.sort_indices()
+    rng = np.random.default_rng(0)
+    sig = []
+    for _ in range(2):
+        w = rng.integers(1, 2**63 - 1, size=A.shape[1], dtype=np.int64).astype(np.uint64)
+        vals = np.concatenate([w[A.indices], np.zeros(1, dtype=np.uint64)])
+        starts = A.indptr[:-1]
+        s = np.add.reduceat(vals, np.minimum(starts, len(vals) - 1))
+        s[np.diff(A.indptr) == 0] = 0
+        sig.append(s)
+    _, first = np.unique(np.stack(sig, axis=1), axis=0, return_index=True)
+    return A[np.sort(first)]
+
+
+def _packed(D: np.ndarray) -> np.ndarray:
+    """Boolean (k, c) -> (k, ceil(c/64)) uint64 words."""
+    pad = (-D.shape[1]) % 64
+    if pad:
+        D = np.concatenate([D, np.zeros((D.shape[0], pad), dtype=bool)], axis=1)
+    return np.packbits(D, axis=1, bitorder="little").view(np.uint64)
+
+
+def _minimal_sets(B: np.ndarray, deg: np.ndarray, cost: np.ndarray | None = None,
+                  block_words: int = 20_000_000) -> np.ndarray:
+    """Which bit sets (rows of packed B) contain no other set of the list: with ``cost``
+    None, a set is dropped if a strictly smaller one lies inside it (row dominance: the
+    larger constraint is implied); with ``cost``, sets are columns and one is dropped if it
+    lies inside another that costs no more (column dominance; ties keep the lower index)."""
+    k, W = B.shape
+    keep = np.ones(k, dtype=bool)
+    if cost is None:
+        order = np.argsort(deg, kind="stable")
+        kept: list[int] = []
+        s = 0
+        while s < k:
+            d = deg[order[s]]
+            e = s
+            while e < k and deg[order[e]] == d:
+                e += 1
+            grp = order[s:e]
+            if kept:
+                K = B[np.array(kept)]
+                step = max(1, block_words // max(1, len(K) * W))
+                for a in range(0, len(grp), step):
+                    g = grp[a:a + step]
+                    inside = ((K[None, :, :] & ~B[g][:, None, :]) == 0).all(axis=2)
+                    keep[g[inside.any(axis=1)]] = False
+            kept.extend(int(x) for x in grp if keep[x])
+            s = e
+        return keep
+    step = max(1, block_words // max(1, k * W))
+    for a in range(0, k, step):
+        P = B[a:a + step]
+        # q contains p: p & ~q == 0
+        inside = ((P[:, None, :] & ~B[None, :, :]) == 0).all(axis=2)
+        idx = np.arange(a, min(k, a + step))
+        better = (cost[None, :] < cost[idx][:, None]) | (
+            (cost[None, :] == cost[idx][:, None])
+            & ((deg[None, :] > deg[idx][:, None]) | ((deg[None, :] == deg[idx][:, None])
+                                                     & (np.arange(k)[None, :] < idx[:, None]))))
+        inside &= better
+        inside[np.arange(len(idx)), idx] = False
+        keep[idx] = ~inside.any(axis=1)
+    return keep
+
+
+def reduce_dense(A: sparse.csr_matrix, cost: np.ndarray):
+    """``reduce_problem`` on bit sets (rows and columns as packed words), for covering
+    problems with many rows and a few thousand columns at most."""
+    D = A.toarray().astype(bool)
+    rows = np.arange(D.shape[0])
+    cols = np.arange(D.shape[1])
+    forced: list[int] = []
+    while True:
+        S = D[np.ix_(rows, cols)]
+        if S.shape[0] == 0:
+            break
+        deg = S.sum(axis=1)
+        if (deg == 0).any():
+            raise ValueError("a row no candidate covers")
+        ess = np.unique(np.argmax(S[deg == 1], axis=1))
+        if len(ess):
+            forced.extend(cols[ess].tolist())
+            rows = rows[~S[:, ess].any(axis=1)]
+            keep = np.ones(len(cols), dtype=bool)
+            keep[ess] = False
+            cols = cols[keep]
+            continue
+        keep_r = _minimal_sets(_packed(S), deg)
+        rows = rows[keep_r]
+        S = S[keep_r]
+        csize = S.sum(axis=0)
+        keep_c = _minimal_sets(_packed(S.T), csize, cost[cols]) & (csize > 0)
+        cols = cols[keep_c]
+        if keep_r.all() and keep_c.all():
+            break
+    return np.array(sorted(set(forced)), dtype=np.int64), rows, cols

@@ -63,11 +63,22 @@ def uncovered_pairs(cubes: list[Cube], table: np.ndarray, n: int):
 
 
 def hazard_free(cubes: list[Cube], table: np.ndarray, n: int, masks: np.ndarray,
-                values: np.ndarray, time_limit: float = 5.0) -> list[Cube]:
-    """The cover plus the fewest (then smallest) candidate cubes that close every hazard."""
+                values: np.ndarray, time_limit: float = 5.0,
+                timed_out: list[str] | None = None,
+                shared: list[Cube] = ()) -> list[Cube]:
+    """The cover plus the fewest (then smallest) candidate cubes that close every hazard.
+
+    ``shared`` are products built anyway (for other outputs): those inside this output's
+    on ∪ dc cost one OR input instead of a new cell, so they are taken first. When the
+    program's time limit runs out its best answer (or a greedy one) is used and
+    "hazard-free cover" is appended to ``timed_out``."""
     missing = uncovered_pairs(cubes, table, n)
     if not missing:
         return list(cubes)
+    free = _inside_region([c for c in shared if c not in set(cubes)], table)
+    if free:
+        masks = np.concatenate([masks, np.array([c.mask for c in free], dtype=np.int64)])
+        values = np.concatenate([values, np.array([c.value for c in free], dtype=np.int64)])
     A, _ = _pair_coverage(masks, values, missing)
     if A.shape[0] and (np.asarray(A.sum(axis=1)).ravel() == 0).any():
         # candidates miss a pair (they were a partial prime set): add the pair cubes' primes
@@ -77,6 +88,10 @@ def hazard_free(cubes: list[Cube], table: np.ndarray, n: int, masks: np.ndarray,
         A, _ = _pair_coverage(masks, values, missing)
     lits = np.array([int(m).bit_count() for m in masks], dtype=float)
     c = (n + 1) * len(masks) + lits
+    if free:  # a product already built costs its OR input only
+        is_free = np.isin(masks * (1 << n) + values,
+                          [f.mask * (1 << n) + f.value for f in free])
+        c[is_free] = 1.0
     res = milp(c, integrality=np.ones(len(masks)), bounds=Bounds(0, 1),
                constraints=[LinearConstraint(A, 1, np.inf)],
                options={"time_limit": time_limit})
@@ -84,6 +99,8 @@ def hazard_free(cubes: list[Cube], table: np.ndarray, n: int, masks: np.ndarray,
         chosen = np.flatnonzero(res.x > 0.5)
     else:
         chosen = _greedy(A, c)
+    if res.status != 0 and timed_out is not None:
+        timed_out.append("hazard-free cover")
     have = set(cubes)
     added = [Cube(int(masks[i]), int(values[i])) for i in chosen]
     return list(cubes) + [a for a in added if a not in have]
@@ -107,12 +124,20 @@ def _expand_pairs(missing, table: np.ndarray, n: int):
     full = (1 << n) - 1
     ms, vs = [], []
     for low, bit in missing:
-        for m in low.tolist():
-            # a prime found for an earlier pair often holds this one too (a wide function has
-            # thousands of missing pairs and a few primes): expanding each again cost minutes
-            # and gigabytes of duplicate candidates
-            if any(not (mk & bit) and (m & mk) == v for mk, v in zip(ms, vs)):
+        # a prime found for an earlier pair often holds this one too (a wide function has
+        # thousands of missing pairs and a few primes): expanding each again cost minutes
+        # and gigabytes of duplicate candidates
+        left = np.ones(len(low), dtype=bool)
+        if ms:
+            am, av = np.array(ms, dtype=np.int64), np.array(vs, dtype=np.int64)
+            ok = (am & bit) == 0
+            am, av = am[ok], av[ok]
+            for a in range(0, len(am), 256):
+                left &= ~((low[:, None] & am[None, a:a + 256]) == av[None, a:a + 256]).any(1)
+        for j in np.flatnonzero(left).tolist():
+            if not left[j]:
                 continue
+            m = int(low[j])
             mask, value = full & ~bit, m & ~bit
             for k in range(n):
                 b = 1 << (n - 1 - k)
@@ -123,6 +148,7 @@ def _expand_pairs(missing, table: np.ndarray, n: int):
                     mask, value = m2, value & m2
             ms.append(mask)
             vs.append(value)
+            left &= (low & mask) != value
     return np.array(ms, dtype=np.int64), np.array(vs, dtype=np.int64)
 
 
@@ -133,3 +159,18 @@ def _inside(region, mask, value, n) -> bool:
         if not mask & b:
             pts = np.concatenate([pts, pts | b])
     return bool(region[pts].all())
+
+
+def _inside_region(cubes: list[Cube], table: np.ndarray) -> list[Cube]:
+    """The cubes with no point where the table is 0."""
+    if not cubes:
+        return []
+    off = np.flatnonzero(table == 0).astype(np.int64)
+    out = []
+    for a in range(0, len(cubes), 64):
+        blk = cubes[a:a + 64]
+        m = np.array([c.mask for c in blk], dtype=np.int64)
+        v = np.array([c.value for c in blk], dtype=np.int64)
+        meets = ((off[:, None] & m[None, :]) == v[None, :]).any(axis=0)
+        out.extend(c for c, bad in zip(blk, meets) if not bad)
+    return out

@@ -8,6 +8,8 @@ cheap; cube sets are numpy arrays so the pairwise steps are vectorised.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 
 _EMPTY = (np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))
@@ -17,19 +19,22 @@ class TooManyPrimes(Exception):
     """Raised when the prime count passes the caller's cap (the exact method is not practical)."""
 
 
-def prime_implicants(region: np.ndarray, limit: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Primes of the boolean table ``region`` (length 2**n): arrays (masks, values), sorted."""
+def prime_implicants(region: np.ndarray, limit: int | None = None,
+                     deadline: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Primes of the boolean table ``region`` (length 2**n): arrays (masks, values), sorted.
+    Raises TooManyPrimes past ``limit`` primes or past the clock time ``deadline``."""
     size = len(region)
     n = size.bit_length() - 1
     if size != 1 << n:
         raise ValueError("table length must be a power of two")
     memo: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
-    masks, values = _primes(np.ascontiguousarray(region, dtype=bool), n, 0, memo, limit)
+    masks, values = _primes(np.ascontiguousarray(region, dtype=bool), n, 0, memo,
+                            (limit, deadline))
     order = np.lexsort((values, masks))
     return masks[order], values[order]
 
 
-def _primes(f: np.ndarray, n: int, k: int, memo, limit):
+def _primes(f: np.ndarray, n: int, k: int, memo, caps):
     """Primes of cofactor ``f`` over variables k..n-1 (bit of variable k is 1 << (n-1-k))."""
     if not f.any():
         return _EMPTY
@@ -45,10 +50,13 @@ def _primes(f: np.ndarray, n: int, k: int, memo, limit):
     f0, f1 = f[:half], f[half:]
     bit = np.int64(1 << (n - 1 - k))
     if np.array_equal(f0, f1):
-        res = _primes(f0, n, k + 1, memo, limit)
+        res = _primes(f0, n, k + 1, memo, caps)
     else:
-        m0, v0 = _primes(f0, n, k + 1, memo, limit)
-        m1, v1 = _primes(f1, n, k + 1, memo, limit)
+        m0, v0 = _primes(f0, n, k + 1, memo, caps)
+        m1, v1 = _primes(f1, n, k + 1, memo, caps)
+        limit, deadline = caps
+        if deadline is not None and time.perf_counter() > deadline:
+            raise TooManyPrimes("time")
         # pairwise intersections (consensus on x_k): cubes without a literal on x_k
         if limit is not None and len(m0) + len(m1) > limit:
             raise TooManyPrimes(len(m0) + len(m1))
@@ -62,7 +70,7 @@ def _primes(f: np.ndarray, n: int, k: int, memo, limit):
         masks = np.concatenate([cm, m0[keep0] | bit, m1[keep1] | bit])
         values = np.concatenate([cv, v0[keep0], v1[keep1] | bit])
         res = (masks, values)
-        if limit is not None and len(masks) > limit:
+        if caps[0] is not None and len(masks) > caps[0]:
             raise TooManyPrimes(len(masks))
     if key is not None:
         memo[key] = res

@@ -69,6 +69,37 @@ def angle_between_lines(ax, ay, bx, by):
     return np.degrees(np.arccos(np.clip(dot, 0.0, 1.0)))
 
 
+# The design checks' angles over all states in the cheap domain: the tangent of the angle
+# (``Poses.transmission`` and ``singular_margin`` store it with ``Angles.set_tan``), from
+# cross and dot products, a square root or a ratio the closed form already has, no trig per
+# state; the check converts only the extreme to degrees (``Angles.min_deg``).
+
+def line_tan(ax, ay, bx, by):
+    """tan of the acute angle between direction fields a and b: |a×b| / |a·b| (inf: square;
+    NaN where a or b has no length)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.abs(ax * by - ay * bx) / np.abs(ax * bx + ay * by)
+
+
+def line_cotan(ax, ay, bx, by):
+    """tan of (90° - the acute angle between a and b): |a·b| / |a×b|."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.abs(ax * bx + ay * by) / np.abs(ax * by - ay * bx)
+
+
+def arccos_tan(c):
+    """tan of arccos(c) for c in 0..1 (clipped): sqrt(1 - c²) / c."""
+    c = np.clip(c, 0.0, 1.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.sqrt((1.0 - c) * (1.0 + c)) / c
+
+
+def ratio_tan(y, x):
+    """tan of arctan2(y, x) for y >= 0, x >= 0: y / x (a hot path: call it where division
+    by zero is already silenced)."""
+    return y / x
+
+
 # ---- where a body's points are ----------------------------------------------------------------
 
 def displacement(body: Body | None, poses: Poses, p) -> Coords:

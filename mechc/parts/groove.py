@@ -15,9 +15,10 @@ from mechc.parts.base import (
     Placer,
     SceneBuilder,
     Shape,
-    angle_between_lines,
+    arccos_tan,
     cross,
     lever_arm,
+    line_cotan,
     position,
     unit,
 )
@@ -46,11 +47,11 @@ def lever_from_slot(j: Joint, lever: Body, slot_body: Body | None, poses: Poses,
     poses.theta[lever.id] = np.where(ok, theta, np.nan)
     poses.mark(lever.id, ~ok | poses.bad.get(slot_body.id if slot_body else GROUND,
                                               np.zeros(size, bool)))
-    poses.singular_margin[j.id] = np.degrees(np.arccos(np.clip(np.abs(ratio), 0, 1)))
+    poses.singular_margin.set_tan(j.id, arccos_tan(np.abs(ratio)))
     # transmission: 90° minus the angle between the slot's normal force and the pin's motion
     rx, ry = lever_arm(lever, poses, j.q)
     nx, ny = -d[1], d[0]  # force line: normal to the slot
-    poses.transmission[j.id] = 90.0 - angle_between_lines(nx, ny, -ry, rx)
+    poses.transmission.set_tan(j.id, line_cotan(nx, ny, -ry, rx))
 
 
 def slot_from_pin(j: Joint, slider: Body, pin_body: Body | None, poses: Poses,
@@ -65,14 +66,14 @@ def slot_from_pin(j: Joint, slider: Body, pin_body: Body | None, poses: Poses,
     poses.u[slider.id] = np.broadcast_to(u, (size,)).copy()
     poses.mark(slider.id, np.broadcast_to(poses.bad.get(pin_body.id, np.zeros(size, bool)),
                                           (size,)))
-    slider_mu = 90.0 - angle_between_lines(-d[1], d[0], slider.axis[0], slider.axis[1])
+    slider_mu = line_cotan(-d[1], d[0], slider.axis[0], slider.axis[1])
     mu = np.broadcast_to(np.asarray(slider_mu, dtype=float), (size,))
     arm = lever_arm(pin_body, poses, j.q)
     if arm is not None:  # the lever's side of the pair
         rx, ry = arm
-        mu = np.minimum(mu, 90.0 - angle_between_lines(-d[1], d[0], -ry, rx))
-        poses.singular_margin[j.id] = np.broadcast_to(mu, (size,)).copy()
-    poses.transmission[j.id] = np.broadcast_to(mu, (size,)).copy()
+        mu = np.minimum(mu, line_cotan(-d[1], d[0], -ry, rx))
+        poses.singular_margin.set_tan(j.id, np.broadcast_to(mu, (size,)).copy())
+    poses.transmission.set_tan(j.id, np.broadcast_to(mu, (size,)).copy())
 
 
 class Groove(JointKind):

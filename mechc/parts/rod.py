@@ -16,12 +16,14 @@ from mechc.parts.base import (
     Placer,
     SceneBuilder,
     Shape,
-    angle_between_lines,
     cross,
     lever_arm,
+    line_cotan,
+    line_tan,
     placed_key,
     placed_position,
     position,
+    ratio_tan,
 )
 from mechc.parts.poses import Poses
 
@@ -46,13 +48,13 @@ def slider_from_rod(j: Joint, slider: Body, other: Body | None, poses: Poses,
                                                np.zeros(size, bool)), (size,)))
     # rod direction against the slider's travel
     px, py = mine[0] + poses.u[slider.id] * e[0] - ox, mine[1] + poses.u[slider.id] * e[1] - oy
-    alpha = angle_between_lines(px, py, e[0], e[1])
-    mu = 90.0 - alpha
+    mu = line_cotan(px, py, e[0], e[1])  # 90° less the rod's angle to the travel (tangent)
     arm = lever_arm(other, poses, theirs)
     if arm is not None:  # the lever arm's side of the pair
-        mu = np.minimum(mu, angle_between_lines(arm[0], arm[1], px, py))
-    poses.transmission[j.id] = mu * np.ones(size)
-    poses.singular_margin[j.id] = mu * np.ones(size)
+        mu = np.minimum(mu, line_tan(arm[0], arm[1], px, py))
+    mu = mu * np.ones(size)
+    poses.transmission.set_tan(j.id, mu)
+    poses.singular_margin.set_tan(j.id, mu)
 
 
 def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
@@ -82,6 +84,10 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
         H2 = r2 * inv - A * A
         ok = H2 >= 0
         H = np.sqrt(H2)  # unsolved states (past the toggle): NaN pin, NaN angle
+        # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the
+        # toggle (fmax takes 0 over H's NaN there); kept as its tangent |arm×rod| / |arm·rod|
+        # (the check converts the smallest only)
+        gamma = ratio_tan(np.fmax(H, 0.0), np.abs(0.5 - 0.5 * (r2 + L2) * inv))
     side = float(np.sign(cross((theirs[0] - P[0], theirs[1] - P[1]),
                                 (mine[0] - P[0], mine[1] - P[1])))) or 1.0
     rx, ry = A * dx, A * dy
@@ -108,15 +114,10 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     poses.placed[placed_key(lever, mine)] = (rx, ry)
     if other is not None:
         poses.placed[placed_key(other, theirs)] = (cx, cy)
-    # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the toggle
-    # (fmax takes 0 over H's NaN there)
-    cos_part = np.abs(0.5 - 0.5 * (r2 + L2) * inv)
-    gamma = np.arctan2(np.fmax(H, 0.0), cos_part)
-    gamma *= 180.0 / np.pi
     if gamma.shape != (size,):
         gamma = np.broadcast_to(gamma, (size,)).copy()
-    poses.transmission[j.id] = gamma  # read-only from here on: one array serves both
-    poses.singular_margin[j.id] = gamma
+    poses.transmission.set_tan(j.id, gamma)  # read-only from here on: one array serves both
+    poses.singular_margin.set_tan(j.id, gamma)
 
 
 class Rod(JointKind):

@@ -141,10 +141,31 @@ class Planner:
 class Mapped:
     netlist: Netlist
     implemented: dict[str, str]  # output -> expression of the structure built
+    # the equations built, when the mapper took ``Equations.alternative`` (fewer parts)
+    equations: Equations | None = None
 
 
 def map_sop(eq: Equations, library: Library, opts: MapOptions | None = None) -> Mapped:
-    """Every output onto AND/OR/NOT-family cells (the conventional target)."""
+    """Every output onto AND/OR/NOT-family cells (the conventional target). Where the
+    equations carry an alternative set of covers (per output, against shared across
+    outputs), both are mapped and the one with fewer parts is built: fewer distinct products
+    can still cost more parts (smaller cubes have more literals, each complemented one an
+    inverting stage)."""
+    first = _map_sop(eq, library, opts)
+    if eq.alternative is None:
+        return first
+    other = _map_sop(eq.alternative, library, opts)
+    if _parts(other.netlist, library) < _parts(first.netlist, library):
+        other.equations = eq.alternative
+        return other
+    return first
+
+
+def _parts(nl: Netlist, library: Library) -> int:
+    return sum(library[c.cell].cost(len(c.inputs)) for c in nl.cells.values())
+
+
+def _map_sop(eq: Equations, library: Library, opts: MapOptions | None = None) -> Mapped:
     opts = opts or MapOptions()
     for name in opts.prefer:  # an unknown name is an error, not silently ignored
         library[name]

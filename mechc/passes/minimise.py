@@ -1,9 +1,13 @@
 """Two-level minimisation of every output of a spec: the ``Spec -> Equations`` stage.
 
-Default engine (exact): all prime implicants of on ∪ dc, then a minimum cover by integer
+Per output (exact): all prime implicants of on ∪ dc, then a minimum cover by integer
 programming. When the primes are too many for that (wide, dense functions) the engine falls back
 to expanding each uncovered on-minterm to a prime and covering with those; such results are marked
-``proven: false``. Every result is checked against the spec on every care row before it is used.
+``proven: false``. Several outputs then share one set of products (``logic/multi.py``): the
+fewest distinct products over all outputs, exact where the multi-output primes fit in the time
+limit, else an espresso-style heuristic with a covering program. Every step whose time limit
+runs out is listed in ``Equations.time_limited``. Every result is checked against the spec on
+every care row before it is used.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ from mechc.logic.cover import min_cover, share_covers
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
 from mechc.logic.espresso import check_cover, espresso
 from mechc.logic.hazards import hazard_free
+from mechc.logic.multi import minimise_multi
 from mechc.logic.primes import TooManyPrimes, prime_implicants
 
 
@@ -31,6 +36,9 @@ class MinimiseOptions:
     complements: bool = True  # also minimise each output's complement (for the mapper)
     alt_time_limit: float = 3.0  # seconds per program for those alternatives (never reported)
     hazard_free: bool = True  # also derive covers with consensus terms (see logic/hazards.py)
+    multi_output: bool = True  # one set of products for all outputs (fewest distinct products)
+    multi_time_limit: float = 5.0  # seconds for the multi-output step (at most time_limit)
+    hazard_time_limit: float = 2.0  # seconds per output for the consensus terms (ditto)
 
 
 def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
@@ -42,33 +50,104 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     comps: dict[str, Cover] = {}
     prime_sets = {}
     comp_sets = {}
+    limited: list[str] = []
+    multi = opts.multi_output and len(spec.outputs) > 1 and spec.kind != "fsm"
+    m = len(spec.outputs)
+    # the mapper's alternatives share one budget, so many outputs do not multiply it
+    aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
     for name in spec.outputs:
         table = spec.table(name)
         covers[name], prime_sets[name] = _minimise_table(table, n, opts)
+        if not covers[name].proven and covers[name].method != "expand":
+            limited.append(f"cover of {name}")
         if opts.complements:
-            comps[name], comp_sets[name] = _minimise_alt(_complement(table), n, opts)
+            comps[name], comp_sets[name] = _minimise_alt(_complement(table), n, aopts)
+            if comps[name].method == "greedy" or comps[name].method.endswith("(time limit)"):
+                limited.append(f"complement cover of {name} (a mapper alternative)")
     eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
     if opts.complements:
         for name in spec.outputs:
-            xf = _xor_form(spec.table(name), spec.inputs, opts)
+            xf = _xor_form(spec.table(name), spec.inputs, aopts)
             if xf is not None:
                 eq.xor_forms[name] = xf
-    if opts.share and len(spec.outputs) > 1:
+    if opts.share and len(spec.outputs) > 1 and not multi:  # the multi-output step shares
         _share(spec, eq, prime_sets, opts)
+    if multi:
+        per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
+                               eq.xor_forms)
+        limited.extend(_multi_output(spec, eq, opts))
+        if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
+            _share(spec, per_output, prime_sets, replace(opts, time_limit=min(
+                opts.time_limit, opts.multi_time_limit)))
+            for o in eq.outputs:  # not the multi-output minimum, whatever each one is alone
+                c = per_output.covers[o]
+                per_output.covers[o] = Cover(c.cubes, False, "per-output", c.seconds)
+            eq.alternative = per_output
     eq.shared_terms = count_shared(eq)
     if opts.hazard_free:
+        hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit,
+                                             max(HAZARD_BUDGET / m, 0.2)))
+        # products built for some output: closing a hazard with one costs an OR input only
+        built = list(dict.fromkeys(c for o in spec.outputs for c in eq.covers[o].cubes)) \
+            if multi else []
         for name in spec.outputs:
             table = spec.table(name)
             eq.hazard_free[name] = _with_consensus(eq.covers[name], table, n, prime_sets[name],
-                                                   opts)
+                                                   hopts, limited, name, built)
             if name in comps:
                 eq.hazard_free_complements[name] = _with_consensus(
-                    comps[name], _complement(table), n, comp_sets[name], _alt(opts))
+                    comps[name], _complement(table), n, comp_sets[name], _alt(hopts), limited,
+                    f"complement of {name}")
+    alt = eq.alternative
+    if alt is not None:
+        alt.shared_terms = count_shared(alt)
+        alt.hazard_free_complements = eq.hazard_free_complements
+        if opts.hazard_free:
+            for name in spec.outputs:
+                alt.hazard_free[name] = _with_consensus(
+                    alt.covers[name], spec.table(name), n, prime_sets[name], hopts, limited,
+                    f"{name} (per-output covers)")
+        verify(spec, alt)
+    eq.time_limited = limited
+    if alt is not None:
+        alt.time_limited = limited
     verify(spec, eq)
     return eq
 
 
-def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
+def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions) -> list[str]:
+    """Replace the per-output covers by the multi-output cover when it has fewer distinct
+    products (then literals plus OR inputs); every output's ``proven`` then says whether the
+    multi-output minimum is proven. Returns the steps whose time limit ran out."""
+    n = spec.n
+    tables = np.array([spec.table(o) for o in spec.outputs])
+    on, region = tables == 1, tables != 0
+    start = [eq.covers[o].cubes for o in spec.outputs]
+    dc = [spec.functions[o].dc for o in spec.outputs] if spec.kind == "pla" else None
+    seeds = [[spec.functions[o].on for o in spec.outputs]] if spec.kind == "pla" else []
+    res = minimise_multi(n, on, region, start, dc, min(opts.time_limit, opts.multi_time_limit),
+                         opts.prime_limit, seeds=seeds)
+    old = _cover_cost([eq.covers[o].cubes for o in spec.outputs])
+    new = _cover_cost([res.output_cubes(i) for i in range(len(spec.outputs))])
+    for i, o in enumerate(spec.outputs):
+        c = eq.covers[o]
+        cubes = res.output_cubes(i) if new < old else c.cubes
+        eq.covers[o] = Cover(cubes, res.proven, res.method if new < old
+                             else c.method, c.seconds + res.seconds / len(spec.outputs))
+    return res.time_limited
+
+
+def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
+    """(distinct products, their literals + OR inputs): the parts the mapper builds, products
+    first (each one is a cell with its own fan-out)."""
+    distinct = {c for cubes in covers for c in cubes}
+    return len(distinct), sum(c.literals() for c in distinct) + sum(len(x) for x in covers)
+
+
+def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions, deadline: bool = False):
+    """Exact cover of one output (primes, then the covering program). With ``deadline`` the
+    time limit also bounds the prime generation (a start for the multi-output step), past
+    which primes are grown from the on-minterms instead (method ``expand``)."""
     t0 = time.perf_counter()
     on = np.flatnonzero(table == 1).astype(np.int64)
     dc = np.flatnonzero(table == DC).astype(np.int64)
@@ -76,7 +155,8 @@ def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
         return Cover([], True, "exact", time.perf_counter() - t0), None
     region = table != 0
     try:
-        masks, values = prime_implicants(region, limit=opts.prime_limit)
+        masks, values = prime_implicants(region, limit=opts.prime_limit,
+                                         deadline=t0 + opts.time_limit if deadline else None)
         method_note = None
     except TooManyPrimes:
         masks, values = expand_primes(region, on, n)
@@ -91,11 +171,16 @@ def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions):
     return Cover(cubes, proven, method, time.perf_counter() - t0), (masks, values, on, dc)
 
 
-def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts) -> Cover:
+def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts,
+                    limited: list[str] | None = None, label: str = "",
+                    shared: list[Cube] = ()) -> Cover:
     if primes is None:
         return cover
     masks, values, _on, _dc = primes
-    cubes = hazard_free(cover.cubes, table, n, masks, values, opts.time_limit)
+    timed: list[str] = []
+    cubes = hazard_free(cover.cubes, table, n, masks, values, opts.time_limit, timed, shared)
+    if timed and limited is not None:
+        limited.append(f"hazard-free cover of {label}")
     if len(cubes) == len(cover.cubes):
         return cover
     return Cover(cubes, False, cover.method + "+consensus", cover.seconds)
@@ -104,6 +189,13 @@ def _with_consensus(cover: Cover, table: np.ndarray, n: int, primes, opts) -> Co
 #: Up to this many inputs the mapper's alternative forms are minimised exactly; beyond, by the
 #: espresso-style heuristic (at 10 inputs the exact complement took 1-3 s against 0.1 s).
 ALT_EXACT_MAX_INPUTS = 8
+#: Seconds the mapper's alternative forms of all outputs may take together (per output at most
+#: ``alt_time_limit``): 14 outputs at 3 s each made table3's minimisation take 19 s, while 2 s
+#: over alu4's 8 outputs gave complements that cost 528 more parts (13096 against 12568).
+ALT_BUDGET = 24.0
+#: Seconds the consensus-term programs of all outputs take together (per output at most
+#: ``hazard_time_limit``).
+HAZARD_BUDGET = 2.0
 
 
 def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
@@ -125,7 +217,8 @@ def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
     res = espresso(n, on, dc, (), 0, time_limit=min(opts.time_limit, opts.alt_time_limit))
     masks = np.array([c.mask for c in res.cubes], dtype=np.int64)
     values = np.array([c.value for c in res.cubes], dtype=np.int64)
-    return (Cover(list(res.cubes), False, "espresso", time.perf_counter() - t0),
+    method = "espresso" if res.complete else "espresso (time limit)"
+    return (Cover(list(res.cubes), False, method, time.perf_counter() - t0),
             (masks, values, onm, dcm))
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from mechc.geometry.circles import circle_meeting
 from mechc.ir.mechanism import GROUND, Body, Joint, Part
 from mechc.parts import body_kind, joint_kind
-from mechc.parts.base import angle_between_lines, body_or_ground, cross, displacement, position
+from mechc.parts.base import body_or_ground, cross, displacement, line_tan, position
 from mechc.parts.poses import KinematicsError, Poses, cos_sin
 
 # the closed form's public names (``Poses``, ``position``, ... live with the parts and poses)
@@ -170,9 +170,9 @@ def _try_dyad(b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
             th = (th + np.pi) % (2 * np.pi) - np.pi
             kind.set_turn(body, poses, th, ok, Q0, qx, qy, size)
             poses.mark(body.id, bad)
-        gamma = angle_between_lines(px - ax, py - ay, px - bx, py - by)
-        poses.transmission[j.id] = gamma * np.ones(size)
-        poses.singular_margin[j.id] = gamma * np.ones(size)
+        gamma = line_tan(px - ax, py - ay, px - bx, py - by) * np.ones(size)
+        poses.transmission.set_tan(j.id, gamma)
+        poses.singular_margin.set_tan(j.id, gamma)
         return True
     return False
 

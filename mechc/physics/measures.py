@@ -36,16 +36,15 @@ class CheckStats:
         self.spring: dict[tuple[str, str], float] = {}
 
     def add(self, poses: Poses) -> None:
-        for jid, mu in poses.transmission.items():
-            if np.size(mu):
-                v = float(np.nanmin(mu)) if not np.isnan(mu).all() else np.nan
-                old = self.mu.get(jid, np.inf)
-                self.mu[jid] = v if np.isnan(v) or np.isnan(old) else min(old, v)
-        for jid, m in poses.singular_margin.items():
-            if np.size(m):
-                v = float(np.nanmin(m)) if not np.isnan(m).all() else np.nan
-                old = self.sing.get(jid, np.inf)
-                self.sing[jid] = v if np.isnan(v) or np.isnan(old) else min(old, v)
+        # the angles' extremes are taken in the domain the closed forms give (their tangents):
+        # one value per joint and chunk is converted to degrees (``Angles.min_deg``)
+        for figures, acc in ((poses.transmission, self.mu), (poses.singular_margin, self.sing)):
+            for jid in figures:
+                v = figures.min_deg(jid)
+                if v is None:
+                    continue
+                old = acc.get(jid, np.inf)
+                acc[jid] = v if np.isnan(v) or np.isnan(old) else min(old, v)
         for bid, bad in poses.bad.items():
             self.bad[bid] = self.bad.get(bid, 0) + int(np.count_nonzero(bad))
         for cid in self.mech.order:

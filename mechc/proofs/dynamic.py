@@ -9,6 +9,9 @@ actuator cannot bring its slider to the target (stall); a bilateral joint stretc
 limit or a contact is overrun beyond its limit ("solver error" — pymunk stretches joints
 silently when overdriven or stepped too coarsely, so this is never passed).
 
+Each change starts on a scene built at rest in its start state (a combinational circuit's rest
+is a function of its inputs), so the changes are independent cases: ``jobs`` processes or a Dask
+cluster run them (``mechc.proofs.parallel``) and the report is the serial run's, case by case.
 With ``prune`` each change runs on a scene of only the cells that can move the outputs
 (``mechc.proofs.prune``); off by default, see docs/performance.md for why.
 """
@@ -18,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -28,10 +31,11 @@ from mechc.ir.design import Design
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC
 from mechc.physics.measures import CheckStats
-from mechc.physics.scene import DynSettings, Scene
+from mechc.physics.scene import DynSettings, MoveResult, Scene
 from mechc.proofs.accuracy import HALVING_CASES, ErrorModel, choose, confirm, load_model
 from mechc.proofs.cases import gray_tour, random_walk
 from mechc.proofs.kinematic import sweep
+from mechc.proofs.parallel import run_cases
 from mechc.proofs.prune import FREEZE, blocker, run_case
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
@@ -59,12 +63,92 @@ def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSett
         return prove_with_accuracy(design, spec, lib, settings.accuracy,
                                    tolerance=settings.tolerance, extra=settings.cases,
                                    seed=settings.seed, progress=progress, prune=settings.prune,
-                                   trace=settings.trace)
+                                   trace=settings.trace, jobs=settings.jobs,
+                                   scheduler=settings.scheduler)
     st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
                       move_time=settings.move_time)
     return prove_dynamic(design, spec, lib, st, tolerance=settings.tolerance,
                          extra=settings.cases, seed=settings.seed, progress=progress,
-                         prune=settings.prune or PRUNE_DEFAULT, trace=settings.trace)
+                         prune=settings.prune or PRUNE_DEFAULT, trace=settings.trace,
+                         jobs=settings.jobs, scheduler=settings.scheduler)
+
+
+@dataclass
+class ChangeJob:
+    """What every change of one dynamic proof needs (sent once to each worker)."""
+
+    design: Design
+    names: list[str]  # inputs, most significant bit first
+    types: dict[str, str]  # cell id -> library cell
+    settings: DynSettings
+    cells: list[str] | None  # the scene's cells (None: all)
+    prune: bool
+    freeze: str | None
+    trace: TraceRecorder | None  # only when the changes run in this process
+
+
+@dataclass
+class Change:
+    """One input change: from input vector ``cur`` to ``vec`` (one input differs), with the
+    outputs the spec asks for before and after it (for a trace)."""
+
+    cur: int
+    vec: int
+    before: dict[str, int]
+    after: dict[str, int]
+
+
+@dataclass
+class ChangeRun:
+    """What one change gave: the move, and the scene it ran on."""
+
+    result: MoveResult
+    scene: dict | None = None  # the whole scene's size
+    size: tuple[int, int, int] | None = None  # a pruned scene: cells, dynamic bodies, constraints
+    escalated: bool = False
+    watch_deviation: float = 0.0
+
+
+def run_segment(job: ChangeJob, lib: Library, changes: list[Change]) -> list[ChangeRun]:
+    """Run ``changes`` in order on one scene built at rest in the first one's start state
+    (a pruned scene per change with ``job.prune``)."""
+    mech, names, n = job.design.mechanism, job.names, len(job.names)
+    state = _vec(changes[0].cur, names) if changes else {}
+    state = {k: float(v) for k, v in state.items()}
+    scene = None
+    out: list[ChangeRun] = []
+    for ch in changes:
+        k = n - ((ch.cur ^ ch.vec).bit_length())
+        name = names[k]
+        target = float((ch.vec >> (n - 1 - k)) & 1)
+        if job.prune:
+            run = run_case(job.design.netlist, mech, lib, job.types, job.settings, state, name,
+                           target, freeze=job.freeze)
+            out.append(ChangeRun(_lean(run.result), size=(run.cells, run.bodies,
+                                                           run.constraints),
+                                 escalated=run.escalated, watch_deviation=run.watch_deviation))
+        else:
+            if scene is None:
+                scene = Scene.build(mech, lib, job.types, job.settings, dict(state), job.cells)
+                scene.sink = job.trace
+            tr = job.trace
+            if tr is not None:
+                tr.begin("change", name, _vec(ch.cur, names), _vec(ch.vec, names), ch.before,
+                         ch.after)
+            r = scene.move(name, target)
+            if tr is not None:
+                tr.end()
+            out.append(ChangeRun(_lean(r), scene=_scene_json(scene, [])))
+        state[name] = target
+    return out
+
+
+def _lean(r: MoveResult) -> MoveResult:
+    """The move without what the proof does not read (sample times, watched sliders), so a
+    worker sends less back."""
+    r.t = np.zeros(0)
+    r.watched = {}
+    return r
 
 
 def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSettings | None = None,
@@ -72,11 +156,14 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                   progress: Callable[[int, int], None] | None = None,
                   cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
                   max_cases: int | None = None, record: list | None = None,
-                  freeze: str | None = None, trace: TraceRecorder | None = None
-                  ) -> ProofReport:
-    """``prune``: each change runs on its own scene holding only what can move the outputs
-    (``mechc.proofs.prune``; every change then starts from the closed-form rest pose); else one
-    scene of the whole mechanism (or of ``cells``) runs the whole tour. ``max_cases`` keeps
+                  freeze: str | None = None, trace: TraceRecorder | None = None,
+                  jobs: int = 1, scheduler: str | None = None) -> ProofReport:
+    """Every change is a case of its own: it runs on a scene built at rest (the closed form)
+    in its start state, so cases can run on ``jobs`` processes or on the Dask cluster at
+    ``scheduler`` (:mod:`mechc.proofs.parallel`) and the report is the serial one, case by
+    case. ``prune``: that scene holds only what can move the outputs (``mechc.proofs.prune``);
+    else the whole mechanism (or ``cells``). A design with a stateful cell runs the whole
+    tour on one scene (its rest depends on the past), in this process. ``max_cases`` keeps
     the first changes of the plan only; ``record`` (a list) receives each change's inputs and
     final output positions (for step-halving checks); ``freeze``: which still bodies a pruned
     scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``)."""
@@ -96,10 +183,6 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     if prune and trace is not None:
         raise UsageError("a pose trace records the whole scene: it cannot be taken with "
                          "per-change pruned scenes (--prune)")
-    scene = None if prune else Scene.build(mech, lib, types, st, {k: 0.0 for k in names}, cells)
-    if trace is not None:
-        scene.sink = trace
-    state = {k: 0.0 for k in names}
     sizes: list[tuple[int, int, int]] = []  # pruned scenes: (cells, dynamic bodies, constraints)
     escalated = 0
     max_watch = 0.0
@@ -109,38 +192,40 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     cols = np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in [0, *vectors]],
                     dtype=bool).T
     wants = spec.values_at(cols)  # spec value before (column i) and after (i + 1) each change
+    job = ChangeJob(design, names, types, st, cells, prune, freeze, trace)
+    changes = [Change(cur, vec, {o: int(wants[o][i]) for o in spec.outputs},
+                      {o: int(wants[o][i + 1]) for o in spec.outputs})
+               for i, (cur, vec) in enumerate(zip([0, *vectors], vectors))]
+    # a circuit whose rest depends on its past (a stateful cell) runs the whole tour on one
+    # scene; otherwise every change is a case of its own, on a scene built at its start
+    segments = ([changes] if blocker(design.netlist, lib) is not None
+                else [[c] for c in changes])
+    if trace is not None:  # the recorder lives in this process: the changes run here
+        jobs, scheduler = 1, None
+    runs = [run for seg in run_cases(run_segment, job, segments, lib, jobs, scheduler, progress,
+                                     [len(seg) for seg in segments])
+            for run in seg]
     failures: list[dict] = []
     counts = {"rest": 0, "glitch": 0, "settle": 0, "stall": 0, "solver": 0, "contact": 0}
     max_err = max_vio = max_pen = max_settle = 0.0
     worst_joint = ""
     max_dev = 0.0
-    cur = 0
     steps = 0
-    for i, vec in enumerate(vectors):
-        diff = cur ^ vec
-        k = n - 1 - diff.bit_length() + 1
-        name = names[k]
-        target = (vec >> (n - 1 - k)) & 1
+    for i, (vec, run) in enumerate(zip(vectors, runs)):
+        r = run.result
         if prune:
-            run = run_case(design.netlist, mech, lib, types, st, state, name, float(target),
-                           freeze=freeze)
-            r = run.result
-            sizes.append((run.cells, run.bodies, run.constraints))
+            sizes.append(run.size)
             escalated += run.escalated
             max_watch = max(max_watch, run.watch_deviation)
-        else:
-            if trace is not None:
-                trace.begin("change", name, _vec(cur, names), _vec(vec, names),
-                            {o: wants[o][i] for o in spec.outputs},
-                            {o: wants[o][i + 1] for o in spec.outputs})
-            r = scene.move(name, float(target))
-            if trace is not None:
-                trace.end()
-        state[name] = float(target)
+        k = (n - 1) - ((vectors[i - 1] if i else 0) ^ vec).bit_length() + 1
+        name = names[k]
+        target = (vec >> (n - 1 - k)) & 1
         steps += r.steps
         case = {"inputs": _vec(vec, names), "moving": name, "to": int(target)}
         if record is not None:
-            record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation})
+            record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation,
+                           "max_penetration_mm": r.max_penetration,
+                           "settle_time_s": r.settle_time, "steps": r.steps})
 
         def fail(kind, case=case, **info):
             counts[kind] += 1
@@ -181,9 +266,6 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                 max_dev = max(max_dev, glitch)
                 if glitch > tolerance:
                     fail("glitch", output=o, expected=want, max_deviation=round(glitch, 6))
-        cur = vec
-        if progress:
-            progress(i + 1, len(vectors))
     stats = CheckStats(mech)
     sweep(design, lib, samples=5, stats=stats)
     kin_checks = stats.checks() + mech.synthesis_checks()
@@ -211,7 +293,9 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
             "max_settle_time_s": round(max_settle, 5),
             "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
             "steps": steps,
-            "scene": _scene_json(scene, sizes),
+            "scene": (_scene_json(None, sizes) if prune else runs[0].scene if runs
+                      else _scene_json(Scene.build(mech, lib, types, st,
+                                                   {k: 0.0 for k in names}, cells), [])),
             "pruning": _pruning_json(why_not, sizes, escalated, max_watch, len(mech.order),
                                      freeze),
             "settings": st.to_json(),

@@ -102,8 +102,7 @@ class ProofReport(Mapping):
         kinds = self.failure_kinds
         extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
         # a sampled proof says so where the verdict is read, not only in --report
-        cases = (f"{self.cases} sampled cases (not exhaustive)"
-                 if self.coverage.get("exhaustive") is False else f"{self.cases} cases")
+        cases = sampled_text(self.cases, self.coverage)
         lines.append(f"{verdict}: level {self.level}, {cases}, "
                      f"{self.failure_count} failures{extra}, {self.seconds:.3f} s")
         lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
@@ -115,6 +114,21 @@ class ProofReport(Mapping):
                          "levels check them):")
             lines += [f"  {h['kind']}: {h['requires']}" for h in hazards[:10]]
         return "\n".join(lines)
+
+
+def sampled_text(cases: int, coverage: dict) -> str:
+    """'1024 cases', or for a proof that is not exhaustive 'sampled 512 of 32768 cases' (and of
+    the single-input changes, where the engine says how many there are)."""
+    if coverage.get("exhaustive") is not False:
+        return f"{cases} cases"
+    total = coverage.get("cases_total")
+    if total is None:
+        return f"{cases} sampled cases (not exhaustive)"
+    text = (f"all {cases} cases" if cases >= total else f"sampled {cases} of {total} cases")
+    tr, tr_total = coverage.get("transitions"), coverage.get("transitions_total")
+    if tr is not None and tr_total is not None and tr < tr_total:
+        text += f", sampled {tr} of {tr_total} single-input changes"
+    return text + " (not exhaustive)"
 
 
 def failure_text(f: dict) -> str:

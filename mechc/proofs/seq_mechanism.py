@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,7 +26,8 @@ from mechc.ir.seqspec import SeqSpec
 from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
-from mechc.physics.scene import DynSettings, Scene
+from mechc.physics.scene import DynSettings, MoveResult, Scene
+from mechc.proofs.parallel import run_cases
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.seq_logic import expected_after, expected_states, transition_tour
@@ -210,6 +212,48 @@ def _last(outs: dict[str, np.ndarray]) -> dict[str, float]:
     return {o: float(np.ravel(v)[-1]) for o, v in outs.items()}
 
 
+@dataclass
+class WalkJob:
+    """What every walk of one sequential dynamic proof needs (sent once to each worker)."""
+
+    design: Design
+    types: dict[str, str]
+    settings: DynSettings
+    trace: TraceRecorder | None  # only when the walks run in this process
+
+
+def run_walk(job: WalkJob, lib: Library, case) -> list[tuple[MoveResult, list[str]]]:
+    """One sequence (``case``: index, input vectors, expected outputs, expected states for a
+    trace) on a fresh scene from power-up: per step the move and the MEMORY cells whose SET
+    and RESET bound."""
+    si, seq, want, state_names = case
+    mech, types, trace = job.design.mechanism, job.types, job.trace
+    cur = {k: float(v) for k, v in seq[0].items()}
+    scene = Scene.build(mech, lib, types, job.settings, cur)
+    watch = _memory_inputs(mech, lib, types, scene)
+    scene.watch = [b for pair in watch.values() for b in pair]
+    if trace is not None:
+        scene.sink = trace
+        trace.begin("rest", None, seq[0], seq[0], want[0], want[0], sequence=si, step=0,
+                    expected_state=state_names[0])
+        trace.sample(scene, 0.0, 1.0)
+        trace.end()
+    out = []
+    for k in range(1, len(seq)):
+        moved = next(n for n in seq[k] if seq[k][n] != cur[n])
+        if trace is not None:
+            trace.begin("change", moved, seq[k - 1], seq[k], want[k - 1], want[k],
+                        sequence=si, step=k, expected_state=state_names[k])
+        r = scene.move(moved, float(seq[k][moved]))
+        if trace is not None:
+            trace.end()
+        binding = _binding(mech, lib, types, watch, r.watched)
+        r.t, r.watched = np.zeros(0), {}  # not read by the proof: less to send back
+        out.append((r, binding))
+        cur[moved] = float(seq[k][moved])
+    return out
+
+
 @engine("dynamic", "sequential")
 def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
                               settings: ProofSettings,
@@ -218,7 +262,8 @@ def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
                       move_time=settings.move_time)
     return prove_sequential_dynamic(design, spec, lib, settings=st,
                                     tolerance=settings.tolerance, seed=settings.seed,
-                                    progress=progress, trace=settings.trace)
+                                    progress=progress, trace=settings.trace,
+                                    jobs=settings.jobs, scheduler=settings.scheduler)
 
 
 def prove_sequential_dynamic(design: Design, spec, lib: Library,
@@ -226,52 +271,53 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
                              seed: int = 0, random_walks: int = 2,
                              progress: Callable[[int, int], None] | None = None,
                              sequences: list[list[dict[str, int]]] | None = None,
-                             trace: TraceRecorder | None = None) -> ProofReport:
+                             trace: TraceRecorder | None = None, jobs: int = 1,
+                             scheduler: str | None = None,
+                             record: list | None = None) -> ProofReport:
     """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
-    each from the power-up inputs); a fresh scene per sequence starts at power-up. Without
+    each from the power-up inputs); a fresh scene per sequence starts at power-up, so the
+    sequences are independent cases: ``jobs`` processes or the Dask cluster at ``scheduler``
+    run them (``mechc.proofs.parallel``), merged in the serial order. ``record`` (a list)
+    receives each step's figures. Without
     ``settings``, the defaults with the circuit's settle allowance (``dyn_settings``).
     ``trace`` receives every body's pose at power-up and along every step."""
     t0 = time.perf_counter()
-    mech, types = design.mechanism, _types(design)
+    mech = design.mechanism
     st = settings or dyn_settings(design, lib)
     walks = (_walks(spec, seed, random_walks) if sequences is None
              else [(s, expected_after(spec, s)) for s in sequences])
-    total = sum(len(s) - 1 for s, _ in walks)
     fails = _Failures()
     _synthesis_failures(fails, design)
     dev = [0.0]
     max_vio = max_pen = max_err = max_settle = 0.0
     worst = ""
     done = 0
-    for si, (seq, want) in enumerate(walks):
+    job = WalkJob(design, _types(design), st, trace)
+    cases = [(si, seq, want, expected_states(spec, seq) if trace is not None else [])
+             for si, (seq, want) in enumerate(walks)]
+    if trace is not None:  # the recorder lives in this process: the walks run here
+        jobs, scheduler = 1, None
+    results = run_cases(run_walk, job, cases, lib, jobs, scheduler, progress,
+                        [len(seq) - 1 for seq, _ in walks])
+    for si, ((seq, want), steps) in enumerate(zip(walks, results)):
         cur = {k: float(v) for k, v in seq[0].items()}
-        scene = Scene.build(mech, lib, types, st, cur)
-        watch = _memory_inputs(mech, lib, types, scene)
-        scene.watch = [b for pair in watch.values() for b in pair]
-        state_names = expected_states(spec, seq) if trace is not None else []
-        if trace is not None:
-            scene.sink = trace
-            trace.begin("rest", None, seq[0], seq[0], want[0], want[0], sequence=si, step=0,
-                        expected_state=state_names[0])
-            trace.sample(scene, 0.0, 1.0)
-            trace.end()
-        for k in range(1, len(seq)):
+        for k, (r, binding) in enumerate(steps, start=1):
             moved = next(n for n in seq[k] if seq[k][n] != cur[n])
-            if trace is not None:
-                trace.begin("change", moved, seq[k - 1], seq[k], want[k - 1], want[k],
-                            sequence=si, step=k, expected_state=state_names[k])
-            r = scene.move(moved, float(seq[k][moved]))
-            if trace is not None:
-                trace.end()
             where = {"sequence": si, "step": k, "moving": moved, "to": int(seq[k][moved]),
                      "inputs": {n: int(v) for n, v in seq[k].items()}}
+            if record is not None:
+                record.append({**where, "final": dict(r.final),
+                               "max_violation_mm": r.max_violation,
+                               "max_penetration_mm": r.max_penetration,
+                               "settle_time_s": r.settle_time, "steps": r.steps,
+                               "binding": binding})
             if r.max_violation > max_vio:
                 max_vio, worst = r.max_violation, r.worst_joint
             max_pen = max(max_pen, r.max_penetration)
             if not r.max_violation <= st.violation_limit:
                 fails.add("solver", **where, message=f"solver error: joint {r.worst_joint} "
                           f"stretched {r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
-            for c in _binding(mech, lib, types, watch, r.watched):
+            for c in binding:
                 fails.add("S·R overlap", **where, cell=c, message=f"MEMORY {c}: SET and RESET "
                           "pressed the lever from both sides at once (binds)")
             if r.max_penetration > st.penetration_limit:
@@ -291,8 +337,6 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
                            dev)
             cur[moved] = float(seq[k][moved])
             done += 1
-            if progress:
-                progress(done, total)
     return ProofReport(
         level="dynamic", kind="sequential", passed=fails.total == 0, cases=done,
         coverage={"sequences": len(walks), "seed": seed, "tolerance_fraction": tolerance},

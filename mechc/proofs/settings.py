@@ -33,6 +33,10 @@ class ProofSettings:
     dt: float | None = None  # dynamic: solver time step (s); None: DynSettings' default
     iterations: int | None = None  # dynamic: solver iterations per step
     move_time: float | None = None  # dynamic: seconds an input takes to move
+    # dynamic: processes the cases run on, or the address of a Dask scheduler to run them on
+    # (mechc.proofs.parallel); neither changes what the proof reports
+    jobs: int = field(default=1, compare=False)
+    scheduler: str | None = field(default=None, compare=False)
     # kinematic and dynamic: receives every body's pose in every case visited (nothing is
     # recorded without one); it never changes what the proof checks or reports
     trace: TraceRecorder | None = field(default=None, compare=False, repr=False)

@@ -1,0 +1,173 @@
+"""Multi-output minimisation on MCNC two-level PLAs against espresso, run in the same process.
+
+    python benchmarks/mcnc.py DIR [--max-inputs 16] [--markdown]
+    python benchmarks/mcnc.py            # the small PLAs under tests/logic/pla (for CI)
+
+For every .pla in DIR with at most ``--max-inputs`` inputs: mechc's distinct products (what
+espresso's ``.p`` counts) and minimisation seconds; espresso's product count from the original
+espresso through pyeda (``pip install -e '.[bench]'``), or, where pyeda is not installed, the
+published count from the table below; and the parts of the mapped design (AND/OR/NOT-family
+cells, before amplifiers) with the per-output minimiser of before multi-output minimisation
+(``multi_output=False``) and with the default one. Every cover is checked against the spec on
+every vector by the minimiser itself. ``--markdown`` rewrites the table in
+docs/minimisation.md. The MCNC PLAs (the LGSynth'91 two-level suite) are not shipped with mechc.
+Exit status 1 if mechc has more products than espresso on any PLA.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+from mechc.cells.library import load_library
+from mechc.frontends.pla import parse_pla_file
+from mechc.passes.map import map_equations
+from mechc.passes.minimise import MinimiseOptions, minimise
+
+ROOT = Path(__file__).resolve().parents[1]
+DOC = ROOT / "docs" / "minimisation.md"
+BEGIN, END = "<!-- mcnc table begin -->", "<!-- mcnc table end -->"
+#: espresso's product counts on the MCNC PLAs (multi-output heuristic cover), used only when
+#: pyeda is not installed.
+PUBLISHED = {"5xp1": 65, "9sym": 86, "Z5xp1": 76, "alu4": 575, "apex4": 435, "b12": 42,
+             "clip": 119, "ex1010": 286, "ex_dc2": 39, "ex_f51m": 77, "ex_root": 57,
+             "ex_sqr6": 53, "rd53": 31, "rd73": 127, "rd84": 255, "sao2": 58, "t481": 481,
+             "table3": 175, "misex1": 12, "bw": 22, "ex5": 74, "misex2": 28, "misex3c": 197}
+
+
+def espresso_products(path: Path) -> tuple[int | None, float, str]:
+    """(products, seconds, source) from pyeda's espresso on the PLA's own rows."""
+    try:  # benchmark-only dependency (the bench extra)
+        from pyeda.boolalg.espresso import DTYPE, FTYPE, RTYPE, espresso, set_config
+    except ImportError:
+        return PUBLISHED.get(path.stem), 0.0, "published"
+    n = m = 0
+    kind = "fd"
+    rows = set()
+    for raw in path.read_text().splitlines():
+        line = raw.split("#")[0].strip()
+        if not line:
+            continue
+        if line.startswith("."):
+            parts = line.split()
+            if parts[0] == ".i":
+                n = int(parts[1])
+            elif parts[0] == ".o":
+                m = int(parts[1])
+            elif parts[0] == ".type":
+                kind = parts[1]
+            continue
+        chars = [c for c in line if c not in " \t|"]
+        inp = tuple({"0": 1, "1": 2}.get(c, 3) for c in chars[:n])
+        out = tuple({"1": 1, "4": 1, "-": 2, "2": 2}.get(c, 0) for c in chars[n:n + m])
+        if kind in ("fr", "fdr"):
+            out = tuple({"1": 1, "4": 1, "-": 2, "2": 2, "0": 0, "3": 0}.get(c, 3)
+                        for c in chars[n:n + m])
+        rows.add((inp, out))
+    intype = {"f": FTYPE, "fd": FTYPE | DTYPE, "fr": FTYPE | RTYPE,
+              "fdr": FTYPE | DTYPE | RTYPE}.get(kind)
+    if intype is None:
+        return PUBLISHED.get(path.stem), 0.0, "published"
+    if kind in ("fr", "fdr"):
+        # pyeda reads 0 as off, 1 as on, 2 as don't care; a '~' (3 here) is left out
+        rows = {(i, tuple(2 if v == 3 else v for v in o)) for i, o in rows}
+    set_config(single_expand=False, remove_essential=True, force_irredundant=True,  # defaults
+               unwrap_onset=True, recompute_onset=False, use_super_gasp=False,
+               skip_make_sparse=False)
+    t0 = time.perf_counter()
+    cover = espresso(n, m, rows, intype=intype)
+    return len({inp for inp, _ in cover}), time.perf_counter() - t0, "pyeda"
+
+
+def mapped(eq, lib) -> tuple[int, int]:
+    """(parts, distinct products) of the design the mapper builds (it may take the
+    per-output covers the equations carry as their alternative, where those cost fewer)."""
+    m = map_equations(eq, lib)
+    built = m.equations if m.equations is not None else eq
+    return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values()), built.products
+
+
+def run(paths: list[Path]) -> list[dict]:
+    lib = load_library()
+    out = []
+    for path in paths:
+        spec = parse_pla_file(path)
+        t0 = time.perf_counter()
+        eq = minimise(spec)
+        seconds = time.perf_counter() - t0
+        t1 = time.perf_counter()
+        before = minimise(spec, MinimiseOptions(multi_output=False))
+        before_seconds = time.perf_counter() - t1
+        esp, esp_s, source = espresso_products(path)
+        parts_after, built = mapped(eq, lib)
+        row = {"name": path.stem, "inputs": spec.n, "outputs": len(spec.outputs),
+               "products": eq.products, "espresso": esp, "espresso_s": esp_s, "source": source,
+               "seconds": seconds, "proven": eq.proven, "limited": len(eq.time_limited),
+               "before_products": before.products, "before_s": before_seconds,
+               "parts_before": mapped(before, lib)[0], "parts_after": parts_after,
+               "built_products": built}
+        out.append(row)
+        print(f"{row['name']:>10} {row['inputs']:>3} {row['outputs']:>3} "
+              f"products {row['products']:>4} (espresso {esp}, before {row['before_products']})"
+              f" {seconds:6.2f} s{' proven' if eq.proven else ''}"
+              f"{f' [{len(eq.time_limited)} time limits]' if eq.time_limited else ''}"
+              f"  parts {row['parts_before']} -> {row['parts_after']} "
+              f"(built with {built} products)", flush=True)
+    return out
+
+
+def markdown(rows: list[dict]) -> str:
+    lines = ["| PLA | in | out | mechc products | espresso products | per-output products "
+             "| mechc s | proven | parts per-output | parts now | products built |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['name']} | {r['inputs']} | {r['outputs']} | {r['products']} | "
+                     f"{r['espresso']} | {r['before_products']} | {r['seconds']:.1f} | "
+                     f"{'yes' if r['proven'] else 'no'} | {r['parts_before']} | "
+                     f"{r['parts_after']} | {r['built_products']} |")
+    sources = sorted({r["source"] for r in rows})
+    lines.append("")
+    lines.append(f"espresso counts: {', '.join(sources)} (pyeda: the original espresso run "
+                 "in the same process).")
+    return "\n".join(lines)
+
+
+def write_doc(table: str) -> None:
+    text = DOC.read_text()
+    a, b = text.index(BEGIN) + len(BEGIN), text.index(END)
+    DOC.write_text(text[:a] + "\n" + table + "\n" + text[b:])
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("dir", nargs="?", default=str(ROOT / "tests" / "logic" / "pla"),
+                    help="directory of .pla files (default: the small PLAs of the tests)")
+    ap.add_argument("--max-inputs", type=int, default=16)
+    ap.add_argument("--only", nargs="*", help="PLA names (file stems) to run")
+    ap.add_argument("--markdown", action="store_true",
+                    help="rewrite the table in docs/minimisation.md")
+    args = ap.parse_args(argv)
+    paths = sorted(Path(args.dir).glob("*.pla"))
+    if args.only:
+        paths = [p for p in paths if p.stem in args.only]
+    paths = [p for p in paths if parse_pla_file(p).n <= args.max_inputs]
+    if not paths:
+        print(f"no PLA of at most {args.max_inputs} inputs in {args.dir}", file=sys.stderr)
+        return 2
+    rows = run(paths)
+    worse = [r["name"] for r in rows if r["espresso"] is not None
+             and r["products"] > r["espresso"]]
+    slow = [r["name"] for r in rows if r["seconds"] > 10]
+    more_parts = [r["name"] for r in rows if r["parts_after"] > r["parts_before"]]
+    print(f"more products than espresso: {worse or 'none'}; over 10 s: {slow or 'none'}; "
+          f"more parts than before: {more_parts or 'none'}")
+    if args.markdown:
+        write_doc(markdown(rows))
+        print(f"wrote the table in {DOC.relative_to(ROOT)}")
+    return 1 if worse else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
