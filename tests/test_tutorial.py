@@ -29,8 +29,10 @@ def _steps() -> list[tuple[list[str], list[str]]]:
 
 
 def _norm(line: str) -> str:
-    """Seconds vary from run to run: '0.22 s' and '9.129 s' both read 'T s'."""
-    return re.sub(r"\d+(\.\d+)? s\b", "T s", line.rstrip())
+    """Seconds vary from run to run: '0.22 s' and '9.129 s' both read 'T s'; a file's size in
+    KB follows every change of the drawing and reads 'N KB'."""
+    line = re.sub(r"\d+(\.\d+)? s\b", "T s", line.rstrip())
+    return re.sub(r"\d+ KB\b", "N KB", line)
 
 
 def _shown_in(shown: list[str], got: str) -> None:

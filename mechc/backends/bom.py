@@ -5,7 +5,10 @@ Rows by ``category``:
 
 - ``plate``: a piece cut from plate (mechc/backends/fabrication.py), identical pieces of one
   plane on one row; its plane, material, length x width x thickness and number of holes;
-- ``link``: the bar of a rod joint (no plane in the design), with the same figures;
+- ``link``: the bar of a rod joint, with the same figures (its plane: the parts list's);
+- ``frame``: the ground's plates (mechc/backends/frame.py): the base plate, with its holes and
+  slots, and the stop blocks; ``screw``: what fixes them (the base plate's mounting screws, a
+  screw per stop block);
 - ``spring``: music-wire springs as designed (mechc/cells/springs.py): rate, preload, largest
   force, free length, wire and mean coil diameter, active coils, extension or compression;
 - ``pin``: steel dowel pins by diameter and the plates they pass (grip = plates x thickness;
@@ -22,7 +25,7 @@ import io
 import math
 from collections.abc import Callable, Hashable, Iterable
 
-from mechc.backends.fabrication import Fabrication, Piece
+from mechc.backends.fabrication import ROD_LINK, Fabrication, Piece
 
 COLUMNS = ("category", "item", "count", "plane", "material", "length_mm", "width_mm",
            "thickness_mm", "holes", "diameter_mm", "grip_mm", "rate_N_per_mm", "preload_N",
@@ -60,13 +63,24 @@ def bom_rows(fab: Fabrication) -> list[dict]:
         p = group[0]
         length, width = p.size()
         rows.append({
-            "category": "link" if p.plane is None else "plate",
+            "category": ("link" if p.role == ROD_LINK else "frame" if p.kind == "frame"
+                         else "plate"),
             "item": p.role or p.kind, "count": len(group),
             "plane": "" if p.plane is None else p.plane, "material": fab.material,
             "length_mm": _r(length, 2), "width_mm": _r(width, 2), "thickness_mm": fab.thickness,
             "holes": len(p.holes),
             "notes": f"{p.kind}; outline area {p.outline.area:.1f} mm2",
             "ids": " ".join(q.id for q in group)})
+    if fab.frame is not None:
+        feats = fab.frame.features
+        for kind, item, size in (("mount", "screw M4 (frame to the bench)", "M4"),
+                                 ("stop", "screw M3 (stop block to the base plate)", "M3")):
+            ids = [f.ref for f in feats if f.kind == kind]
+            if ids:
+                rows.append({"category": "screw", "item": item, "count": len(ids),
+                             "diameter_mm": size[1:], "notes": "length: the plates it passes "
+                             "and the bench's or spacer's depth", "ids": " ".join(ids)})
+
     def spring_key(s):
         c = s.coil
         return (round(s.rate, 6), round(s.preload, 4), round(s.max_force or 0.0, 4),

@@ -6,9 +6,9 @@ polylines); ``plane N labels`` holds each part's name (engrave it, or hide the l
 ``sheets`` the stock sheets' borders and titles (never cut). Every plane is cut from the same
 plate, so all parts are nested together (mechc/backends/nest.py) on as few sheets as the
 packing finds, side by side in the drawing; ``by_plane`` gives each plane sheets of its own,
-one row per plane. The links of rod joints, to which the design gives no plane, go on layer
-``rod links``. Millimetres, set in the
-header ($INSUNITS 4, $MEASUREMENT 1).
+one row per plane. The links of rod joints go on the planes the parts list gives them
+(mechc/backends/fabrication.py), and the frame's plates (base plate, stop blocks) on layer
+``frame``. Millimetres, set in the header ($INSUNITS 4, $MEASUREMENT 1).
 
 Every outline carries, as XDATA of the application ``MECHC``, the part's name, plane and the
 placement that put it on the sheet (turn in degrees about the design's origin, then the
@@ -31,7 +31,7 @@ from mechc.backends.fabrication import Fabrication, Hole, Piece
 from mechc.backends.nest import Placement, nest
 
 APPID = "MECHC"
-LINKS = "rod links"
+FRAME = "frame"
 SHEETS = "sheets"
 #: Room between rows and columns of sheets in the drawing (titles sit in it), mm.
 SHEET_SPACING = 60.0
@@ -41,7 +41,7 @@ COLOURS = (1, 5, 94, 6, 30, 150, 200, 12, 8, 3)
 
 @dataclass(frozen=True)
 class SheetInfo:
-    group: str  # "all planes", or with by_plane a cut layer: "plane N" or "rod links"
+    group: str  # "all planes", or with by_plane a cut layer: "plane N" or "frame"
     index: int  # sheet number within its group, from 0 (XDATA's sheet: the index in the list)
     origin: tuple[float, float]  # lower left in the drawing, mm
     size: tuple[float, float]
@@ -55,8 +55,9 @@ class DxfResult:
     oversize: list[str]
 
 
-def layer_name(plane: int | None) -> str:
-    return LINKS if plane is None else f"plane {plane}"
+def layer_name(piece: Piece) -> str:
+    """The cut layer of ``piece``: its plane's, or the frame's."""
+    return FRAME if piece.kind == "frame" or piece.plane is None else f"plane {piece.plane}"
 
 
 def write_dxf(fab: Fabrication, sheet: tuple[float, float] = (1000.0, 600.0),
@@ -81,17 +82,18 @@ def _write(fab: Fabrication, sheet: tuple[float, float], gap: float,
     doc.appids.add(APPID)
     doc.layers.add(SHEETS, color=8)
     msp = doc.modelspace()
-    planes = sorted({p.plane for p in fab.pieces if p.plane is not None})
-    if any(p.plane is None for p in fab.pieces):
-        planes.append(None)
-    for i, plane in enumerate(planes):
+    planes = sorted({p.plane for p in fab.pieces if layer_name(p) != FRAME})
+    layers = [f"plane {k}" for k in planes]
+    if any(layer_name(p) == FRAME for p in fab.pieces):
+        layers.append(FRAME)
+    for i, name in enumerate(layers):
         colour = COLOURS[i % len(COLOURS)]
-        doc.layers.add(layer_name(plane), color=colour)
-        doc.layers.add(f"{layer_name(plane)} labels", color=colour)
+        doc.layers.add(name, color=colour)
+        doc.layers.add(f"{name} labels", color=colour)
     groups: dict[str, list[Piece]] = {}
     for p in fab.pieces:
-        groups.setdefault(layer_name(p.plane) if by_plane else "all planes", []).append(p)
-    order = [layer_name(k) for k in planes] if by_plane else ["all planes"]
+        groups.setdefault(layer_name(p) if by_plane else "all planes", []).append(p)
+    order = layers if by_plane else ["all planes"]
     infos: list[SheetInfo] = []
     oversize: list[str] = []
     y = 0.0
@@ -114,7 +116,7 @@ def _write(fab: Fabrication, sheet: tuple[float, float], gap: float,
             ox, oy = origins[pl.sheet]
             piece = pieces[pid]
             _part(msp, piece, Placement(pl.sheet, pl.angle, pl.dx + ox, pl.dy + oy),
-                  layer_name(piece.plane), len(infos) - len(nested.sizes) + pl.sheet)
+                  layer_name(piece), len(infos) - len(nested.sizes) + pl.sheet)
         y -= row_h + SHEET_SPACING
     return DxfResult(_text(doc), infos, oversize)
 

@@ -5,9 +5,15 @@ read this one list, so a sheet, a model and a parts list never disagree about wh
 
 A body whose polygons sit on several planes (``poly_layers``: a bar whose far end crosses
 over other parts) is several plates, one per plane; each connected piece of a plane is one
-part. A pin hole is cut in every piece of the pin's body whose outline holds the whole hole;
-a pin the outline does not hold (its centre on or past the edge) gets no hole and is listed
-in ``Fabrication.unholed`` so the writers can say so.
+part. A pin hole is cut in every piece of the pin's body whose outline holds the whole hole
+(the design gives every pin a boss: mechc/passes/bosses.py); a pin the outline does not hold
+(a design written before bosses) gets no hole and is listed in ``Fabrication.unholed`` so the
+writers can say so.
+
+The link of a rod joint (a massless bar in a cell) has no plane in the design; it is put on a
+plane of links above every part (``link_planes``): links that could meet go on different
+planes. The frame (mechc/backends/frame.py) adds the ground's parts: the base plate under the
+lowest plane and the stop blocks (kind ``frame``), and a guide peg's hole in every slider.
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from dataclasses import dataclass, field
 from shapely.geometry import LineString, Point, Polygon
 from shapely.ops import unary_union
 
+from mechc.backends.frame import Frame, build_frame
 from mechc.cells.materials import MATERIALS, PIN_MATERIAL
 from mechc.ir.mechanism import GROUND, Body, Mechanism, Spring
 from mechc.parts.pushrod import bar_outline
@@ -25,6 +32,8 @@ from mechc.parts.pushrod import bar_outline
 #: Segments per quarter circle when a hole becomes a polygon (meshes only; the DXF keeps
 #: circles): 16 keeps the polygon within 0.05 % of the hole's radius.
 HOLE_RESOLUTION = 16
+#: The role of a rod joint's link (its kind is "link", as a free link body's is).
+ROD_LINK = "rod link"
 
 
 @dataclass(frozen=True)
@@ -50,9 +59,9 @@ class Piece:
 
     id: str
     body: str
-    kind: str  # the body's kind, or "link" for the bar of a rod joint
+    kind: str  # the body's kind; "link" for a rod joint's too (role ROD_LINK); "frame"
     role: str
-    plane: int | None  # None: a rod joint's link, for which the design names no plane
+    plane: int | None  # a link's and the frame's: given here (the design names none)
     outline: Polygon
     holes: list[Hole] = field(default_factory=list)
 
@@ -100,6 +109,7 @@ class Fabrication:
     motors: list[Body]  # rotor bodies: powered rollers
     rollers: list[tuple[str, float]]  # touch joints' rollers: (joint, diameter mm)
     unholed: list[tuple[str, str]] = field(default_factory=list)  # (joint, body): no hole cut
+    frame: Frame | None = None
 
     @property
     def planes(self) -> list[int]:
@@ -142,6 +152,7 @@ def fabrication(mech: Mechanism) -> Fabrication:
     pins: list[PinItem] = []
     rollers: list[tuple[str, float]] = []
     unholed: list[tuple[str, str]] = []
+    links: list[Piece] = []  # rod joints' links
 
     def drill(bid: str, hole: Hole) -> tuple[int, ...] | None:
         """Cut ``hole`` in every piece of ``bid`` that holds it; the planes it went through
@@ -177,16 +188,64 @@ def fabrication(mech: Mechanism) -> Fabrication:
                 ends = [drill(j.a, Hole(j.p0, d, j.id, j.p1)), drill(j.b, Hole(j.q, d, j.id))]
                 pins.append(pin(j.id, d, ends, GROUND in (j.a, j.b)))
             elif j.kind == "rod":  # a link of plate, pinned at both ends
-                link = Piece(j.id, j.id, "link", "rod link", None,
+                link = Piece(j.id, j.id, "link", ROD_LINK, None,
                              Polygon(bar_outline(j.pa, j.pb, ctx.bar)))
                 pieces.append(link)
+                links.append(link)
                 for end, bid, at in (("a", j.a, j.pa), ("b", j.b, j.pb)):
                     hole = Hole(at, d, f"{j.id}.{end}")
                     link.holes.append(hole)
                     pins.append(pin(hole.joint, d, [drill(bid, hole)], bid == GROUND, 1))
             elif j.kind == "touch" and j.length:
                 rollers.append((j.id, 2 * float(j.length)))
+    planes = [p.plane for p in pieces if p.plane is not None] or [0]
+    for link, plane in zip(links, link_planes(links, ctx, max(planes) + 1)):
+        link.plane = plane
+        pins = [q if not q.joint.startswith(link.id + ".") else
+                PinItem(q.joint, q.diameter, tuple(sorted({*q.planes, plane})), q.to_ground,
+                        q.unholed, 0) for q in pins]
+    frame = None
+    if pieces:
+        extent = unary_union([p.outline for p in pieces if p.role != ROD_LINK]).bounds
+        frame = build_frame(mech, extent, min(planes))
+        pieces.extend(frame_pieces(frame))
+        for ref, at, d in frame.pegs:  # a guide peg stands in its slider
+            hole = Hole(at, d, f"{ref}.guide")
+            pins.append(pin(hole.joint, d, [drill(ref, hole)], True))
     title = MATERIALS[ctx.material].title if ctx.material in MATERIALS else ctx.material
     return Fabrication(ctx.thickness, title, PIN_MATERIAL.title, ctx.stroke, pieces, springs,
-                       pins, dict(mech.actuators), motors, rollers, unholed)
+                       pins, dict(mech.actuators), motors, rollers, unholed, frame)
+
+
+def link_planes(links: list[Piece], ctx, base: int) -> list[int]:
+    """A plane for each rod joint's link, ``base`` and up: two links go on one plane only when
+    their outlines at rest are further apart than the clearance plus a stroke and its
+    overtravel (each end of a link rides on a bar that moves up to half that either way from
+    the design pose). Greedy, in order: each link takes the lowest plane none of the links it
+    could meet has."""
+    reach = ctx.clearance + ctx.stroke * (1 + 2 * ctx.overtravel)
+    out: list[int] = []
+    for i, p in enumerate(links):
+        taken = {out[k] for k in range(i) if links[k].outline.distance(p.outline) < reach}
+        c = 0
+        while c in taken:
+            c += 1
+        out.append(base + c)
+    return out
+
+
+def frame_pieces(frame: Frame) -> list[Piece]:
+    """The frame's plates: the base plate with a hole or slot per fixed point, and the stop
+    blocks with their screw holes."""
+    base = Piece("frame.base", "ground", "frame", "base plate", frame.plane, frame.base,
+                 [Hole(f.centre, f.diameter, f.ref, f.end) for f in frame.features])
+    out = [base]
+    for jid, plane, block, screw in frame.stops:
+        out.append(Piece(f"frame.stop.{jid}", "ground", "frame", "stop block", plane, block,
+                         [Hole(screw, _screw(frame, jid), f"{jid}.screw")]))
+    return out
+
+
+def _screw(frame: Frame, jid: str) -> float:
+    return next(f.diameter for f in frame.features if f.kind == "stop" and f.ref == jid)
 

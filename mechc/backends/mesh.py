@@ -3,9 +3,10 @@ and as glTF (one node per part, named by it, metres as glTF's units are), throug
 
 Each plate piece (mechc/backends/fabrication.py) is its outline less its pin holes, extruded
 by the plate thickness and stacked at its plane's height: plane k spans z = k t to (k + 1) t
-(plates slide on one another; the frame lies under plane 0). Every part's mesh is checked
-watertight before it is written. The links of rod joints have no plane in the design and are
-left out of the assembly (they are on the cut sheets and in the parts list).
+(plates slide on one another). The frame's base plate lies one plate under the lowest plane,
+its stop blocks on the planes of the bodies they stop; the links of rod joints on the planes
+the parts list gives them (mechc/backends/fabrication.py). Every part's mesh is checked
+watertight before it is written.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """A picture of the 3D assembly (PNG): every part's triangles drawn by matplotlib's 3D axes at
-true proportions, coloured by plane, seen from above at a slant (matplotlib sorts faces by
-depth roughly, so a crossing may show the lower part on top; a glTF viewer shows it right)."""
+true proportions, coloured by plane, seen from above at a slant, lower planes drawn first
+(within a plane matplotlib sorts faces by depth only roughly; a glTF viewer shows it right)."""
 
 from __future__ import annotations
 
@@ -24,10 +24,14 @@ def preview(asm: Assembly, width_in: float = 14.0, dpi: int = 110, elev: float =
     fig = Figure(figsize=(width_in, width_in), dpi=dpi)  # no pyplot: no global state
     canvas = FigureCanvasAgg(fig)
     ax = fig.add_axes((0, 0, 1, 1), projection="3d")
-    for piece, m in asm.parts:
+    # seen from above: lower planes first, each drawn over by the planes above it (matplotlib's
+    # own depth order put the frame's base plate, one large part, over everything)
+    ax.computed_zorder = False
+    for piece, m in sorted(asm.parts, key=lambda pm: pm[0].plane):
         colour = np.array(COLOURS[piece.plane % len(COLOURS)]) / 255.0
         ax.add_collection3d(Poly3DCollection(m.triangles, facecolors=colour,
-                                             edgecolors=colour * 0.6, linewidths=0.1))
+                                             edgecolors=colour * 0.6, linewidths=0.1,
+                                             zorder=piece.plane))
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_zlim(lo[2], hi[2])

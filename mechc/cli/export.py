@@ -27,14 +27,17 @@ BY_SUFFIX = {".dxf": "dxf", ".svg": "svg", ".stl": "stl", ".glb": "gltf", ".gltf
 FORMATS_HELP = """\
 formats:
   dxf    cut sheets for a laser or water-jet cutter, in mm: every part's outline and pin holes,
-         one layer per plane ("plane 0", "plane 1", ...; the links of rod joints on "rod
-         links"), part names on "plane N labels" (engrave or hide), sheet borders on "sheets"
-         (never cut); parts nested without overlap on --sheet sized sheets
+         one layer per plane ("plane 0", "plane 1", ...; the links of rod joints on planes of
+         their own above), the frame (base plate with a hole for every fixed pivot, a guide
+         slot per slider and screw holes; stop blocks) on "frame", part names on "... labels"
+         (engrave or hide), sheet borders on "sheets" (never cut); parts nested without
+         overlap on --sheet sized sheets
   bom    bill of materials (CSV): plates by plane with material and size, springs (rate,
          preload, free length, wire, coils), pins (diameter, grip), rollers, actuators (force,
          stroke) and motors, each with its count and the names of the parts
   stl    the 3D assembly as one mesh in mm: every plate extruded at the plate thickness and
-         stacked at its plane's height (plane k from k*t to (k+1)*t)
+         stacked at its plane's height (plane k from k*t to (k+1)*t), the frame's base plate
+         one plate under the lowest plane
   gltf   the same assembly as glTF 2.0, one named node per part, in metres (glTF's unit);
          -o NAME.glb (binary, default) or NAME.gltf (one text file)
   svg    the to-scale drawing of `mechc draw` at rest (every input off)
@@ -168,10 +171,19 @@ def run(args: argparse.Namespace) -> int:
         lo, hi = asm.bounds
         print(f"{args.design} -> {out}: {len(asm.parts)} parts on {len(fab.planes)} planes, "
               f"{hi[0] - lo[0]:.0f} x {hi[1] - lo[1]:.0f} x {hi[2] - lo[2]:.0f} mm, "
-              f"{len(data) / 1024:.0f} KB (rod-joint links are on the sheets only)"
+              f"{len(data) / 1024:.0f} KB"
               + (f"; drawn to {args.preview}" if args.preview else ""))
     _warn_unholed(fab)
+    _note_frame(fab)
     return EXIT_OK
+
+
+def _note_frame(fab: Fabrication) -> None:
+    crowded = fab.frame.crowded if fab.frame else []
+    if crowded:
+        print(f"mechc: note: {len(crowded)} slider guide slot(s) in the base plate meet "
+              f"another hole of it wherever the peg goes: {', '.join(crowded[:4])}"
+              + (f" and {len(crowded) - 4} more" if len(crowded) > 4 else ""), file=sys.stderr)
 
 
 def _holes(fab: Fabrication) -> int:

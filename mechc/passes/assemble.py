@@ -32,6 +32,7 @@ from mechc.ir.mechanism import (
 )
 from mechc.ir.netlist import Netlist
 from mechc.parts.pushrod import ROLE, PushRod, bar_outline
+from mechc.passes.bosses import add_bosses
 from mechc.passes.route import Piece, assign_planes
 from mechc.passes.strength import size_parts
 
@@ -158,6 +159,7 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                             1.0, ">=", "x"))
     mech = Mechanism(ctx, placed, inputs, nets, outputs, actuators, order, checks)
     size_parts(mech)  # pins and rod guides from the loads just budgeted
+    add_bosses(mech)  # material round every pin, now that the pins are sized
     return mech
 
 
