@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import math
 
+from shapely import STRtree
 from shapely.geometry import MultiPoint, Point, Polygon
 from shapely.ops import nearest_points, unary_union
 
@@ -128,6 +129,15 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
         if "fanout_plane" in part.data:
             net_planes.add(part.data["fanout_plane"])
     net_base = min(net_planes, default=max(planes) + 1)  # nets sit above every cell plane
+    # one spatial index per plane over the polygons assembly drew; bosses added here are few
+    # and checked one by one (a scan of every polygon per pin was quadratic: minutes on a
+    # design of a thousand cells)
+    by_plane: dict[int, list[int]] = {}
+    for k, pl in enumerate(plane_of):
+        by_plane.setdefault(pl, []).append(k)
+    trees = {pl: STRtree([polys[k] for k in ks]) for pl, ks in by_plane.items()}
+    drawn = len(polys)
+    boxes: list[tuple[float, float, float, float]] = []  # bounds of the bosses added
     added = []
     for bid, centre, d, end in pin_sites(mech):
         body = bodies.get(bid)
@@ -147,13 +157,20 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
         # the boss's plane: the body's own if the boss keeps the clearance there from every
         # body it is not pinned to; else the nearest cell plane where it keeps a stroke more
         # (a doubler plate fastened over the body); else that of the body's nearest polygon
-        others = [k for k in range(len(polys))
-                  if owner[k] != bid and exempt.get(frozenset((bid, owner[k]))) != "bearing"]
         room = ctx.clearance + ctx.stroke * (1 + 2 * ctx.overtravel)
 
-        def clear(k: int, margin: float, others=others, g=g) -> bool:
-            near = [polys[i] for i in others if plane_of[i] == k]
-            return not near or min(g.distance(q) for q in near) >= margin
+        def clear(k: int, margin: float, g=g, bid=bid) -> bool:
+            """No polygon on plane ``k`` of a body ``bid`` is not pinned to within ``margin``
+            of ``g``."""
+            near = [by_plane[k][i] for i in trees[k].query(g, predicate="dwithin",
+                                                            distance=margin)] if k in trees else []
+            x0, y0, x1, y1 = g.bounds
+            near += [i for i in range(drawn, len(polys)) if plane_of[i] == k
+                     and boxes[i - drawn][0] <= x1 + margin and boxes[i - drawn][2] >= x0 - margin
+                     and boxes[i - drawn][1] <= y1 + margin and boxes[i - drawn][3] >= y0 - margin]
+            return all(g.distance(polys[i]) >= margin for i in near
+                       if owner[i] != bid
+                       and exempt.get(frozenset((bid, owner[i]))) != "bearing")
 
         if not clear(plane, ctx.clearance):
             ordered = sorted((k for k in planes if k != plane and k < net_base),
@@ -175,5 +192,6 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
         owner.append(bid)
         plane_of.append(plane)
         polys.append(g)
+        boxes.append(g.bounds)
         added.append((bid, plane))
     return added
