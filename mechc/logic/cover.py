@@ -158,28 +158,12 @@ def min_cover(masks: np.ndarray, values: np.ndarray, on_rows: np.ndarray, dc_row
     if len(rows) == 0:
         chosen, proven = forced, True
     else:
-        # two stages (fewest terms, then fewest literals with the term count fixed): several
-        # times faster on cyclic random problems than one lexicographic objective
-        sub = A[rows][:, cols]
-        cover_rows = LinearConstraint(sub, 1, np.inf)
-        k = len(cols)
-        ones = np.ones(k)
-
-        def remaining():
-            return max(0.1, time_limit - (time.perf_counter() - t0))
-
-        res = milp(ones, integrality=ones, bounds=Bounds(0, 1), constraints=[cover_rows],
-                   options={"time_limit": remaining()})
-        if res.x is None:
+        picked, proven = _terms_then_cost(A[rows][:, cols], lits[cols].astype(float),
+                                          lambda: max(0.1, time_limit - (time.perf_counter()
+                                                                         - t0)))
+        if picked is None:
             return CoverResult(g, False, "greedy", time.perf_counter() - t0)
-        terms = int(round(res.x.sum()))
-        proven = res.status == 0
-        res2 = milp(lits[cols].astype(float), integrality=ones, bounds=Bounds(0, 1),
-                    constraints=[cover_rows, LinearConstraint(ones[None, :], terms, terms)],
-                    options={"time_limit": remaining(), "mip_rel_gap": 0.0})
-        x = res2.x if res2.x is not None else res.x
-        proven = proven and res2.status == 0
-        chosen = np.sort(np.concatenate([forced, cols[x > 0.5]]))
+        chosen = np.sort(np.concatenate([forced, cols[picked]]))
     if proven and len(dc_rows) and P <= DC_TIEBREAK_MAX_CANDIDATES:
         better = _fewest_dc(A, c, float(c[chosen].sum()), masks, values, dc_rows, dc_time)
         if better is not None:
@@ -285,29 +269,35 @@ def solve_cover(A: sparse.csr_matrix, lits: np.ndarray, n: int,
         rows, cols = rows[r2], cols[c2]
     if len(rows) == 0:
         return forced, True
-    sub = A[rows][:, cols]
+    picked, proven = _terms_then_cost(
+        A[rows][:, cols], lits[cols].astype(float),
+        lambda: max(0.05, time_limit - (time.perf_counter() - t0)), len(g) - len(forced))
+    if picked is None:
+        return g, False
+    return np.sort(np.concatenate([forced, cols[picked]])), proven
+
+
+def _terms_then_cost(sub: sparse.csr_matrix, cost: np.ndarray, remaining,
+                     max_terms: int | None = None) -> tuple[np.ndarray | None, bool]:
+    """The columns of a cover of every row of ``sub``: fewest columns, then the least ``cost``
+    with that count fixed — two programs, several times faster on cyclic random problems than
+    one lexicographic objective. ``remaining()`` gives each program's time limit. Returns (a
+    mask over the columns, proven), or (None, False) when no cover was found or the fewest
+    exceed ``max_terms`` (the caller has a cover that good already)."""
     cover_rows = LinearConstraint(sub, 1, np.inf)
-    k = len(cols)
-    ones = np.ones(k)
-
-    def remaining():
-        return max(0.05, time_limit - (time.perf_counter() - t0))
-
+    ones = np.ones(sub.shape[1])
     res = milp(ones, integrality=ones, bounds=Bounds(0, 1), constraints=[cover_rows],
                options={"time_limit": remaining()})
     if res.x is None:
-        return g, False
+        return None, False
     terms = int(round(res.x.sum()))
-    proven = res.status == 0
-    if len(forced) + terms > len(g):
-        return g, False
-    res2 = milp(lits[cols].astype(float), integrality=ones, bounds=Bounds(0, 1),
+    if max_terms is not None and terms > max_terms:
+        return None, False
+    res2 = milp(cost, integrality=ones, bounds=Bounds(0, 1),
                 constraints=[cover_rows, LinearConstraint(ones[None, :], terms, terms)],
                 options={"time_limit": remaining(), "mip_rel_gap": 0.0})
     x = res2.x if res2.x is not None else res.x
-    proven = proven and res2.status == 0
-    chosen = np.sort(np.concatenate([forced, cols[x > 0.5]]))
-    return chosen, proven
+    return x > 0.5, res.status == 0 and res2.status == 0
 
 
 def unique_rows(A: sparse.csr_matrix) -> sparse.csr_matrix:
