@@ -57,10 +57,10 @@ def browser():
     """Headless Chromium (the Debian package) driven by playwright, installed if missing."""
     try:
         from playwright.sync_api import sync_playwright
-    except ImportError:
+    except ImportError:  # only outside `make install` (the test extra has it): say how
         pytest.skip("playwright is not installed (pip install -e '.[test]')")
     why = _install_chromium()
-    if why:
+    if why:  # only where Chromium is missing and cannot be installed (not root, no apt)
         pytest.skip(why)
     with sync_playwright() as p:
         b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)

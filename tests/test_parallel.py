@@ -84,7 +84,7 @@ def test_sequential_walks_on_spawned_processes_match_the_serial_walks(toggle, mo
 
 @pytest.mark.slow
 def test_a_dask_cluster_gives_the_serial_proof_case_by_case(sorter, toggle):
-    distributed = pytest.importorskip("distributed")
+    import distributed  # in the test extra: a missing install fails here, never skips
     serial, one = _combinational(sorter)
     seq_serial: list = []
     seq_one = prove_sequential_dynamic(toggle, toggle.spec, LIB, random_walks=1,
@@ -114,7 +114,7 @@ def test_cli_jobs_report_is_the_serial_report(cli, tmp_path):
 
 
 def test_cli_unreachable_scheduler_is_a_clear_error(cli, monkeypatch):
-    pytest.importorskip("distributed")
+    import distributed  # noqa: F401 -- in the test extra: missing fails, never skips
     monkeypatch.setattr(parallel, "CONNECT_TIMEOUT_S", 1)
     code, _, err = cli("simulate", EXAMPLES / "sorter.bool", "--cases", "0",
                        "--scheduler", "tcp://127.0.0.1:1")
