@@ -250,3 +250,29 @@ def test_a_gzip_design_is_the_same_text_and_reads_back(cli, tmp_path):
     broken.write_bytes(gz.read_bytes()[:200])
     code, _, err = cli("simulate", broken, "--level", "logic")
     assert code == 2 and "broken.json.gz: cannot read design: a damaged gzip file" in err
+
+
+def test_what_compile_writes_simulate_and_draw_accept_across_option_values(cli, tmp_path):
+    """A seeded draw of compile's design options, extreme values included: every design compile
+    writes (whatever its exit status) is taken by `simulate --level logic` and by `draw`; a
+    refusal is exit 2 and leaves no file. So no written design is ever refused for its content."""
+    rng = np.random.default_rng(16)
+    written = 0
+    for i in range(8):
+        out = tmp_path / f"d{i}.json"
+        opts = ["--stroke", f"{rng.choice([2.0, 8.0, 20.0, 60.0, 300.0]):g}",
+                "--actuator-force", f"{rng.choice([0.5, 5.0, 50.0, 5e3]):g}",
+                "--output-load", f"{rng.choice([0.0, 0.2, 2.0, 200.0, 1e6]):g}",
+                "--clearance", f"{rng.choice([0.0, 0.5, 1.0, 5.0]):g}",
+                "--material", str(rng.choice(["aluminium", "steel", "acrylic"]))]
+        spec = EXAMPLES / str(rng.choice(["sorter.bool", "majority.pla", "toggle.fsm"]))
+        code, _, err = cli("compile", spec, "-o", out, "--no-prove", *opts)
+        if not out.exists():
+            assert code == 2 and "Traceback" not in err, (opts, err)
+            continue
+        written += 1
+        code, _, err = cli("simulate", out, "--level", "logic")
+        assert code == 0, (opts, err)
+        code, _, err = cli("draw", out, "-o", tmp_path / f"d{i}.svg")
+        assert code == 0, (opts, err)
+    assert written >= 3  # the draw reaches designs, not only refusals
