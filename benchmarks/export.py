@@ -67,7 +67,8 @@ def main() -> None:
     rows = []
     for path in sorted(p for p in EXAMPLES.iterdir() if p.suffix in SUFFIXES):
         rows.append((path.stem + path.suffix, figures(path)))
-        print(f"  {path.name} done", flush=True) if not args.markdown else None
+        if not args.markdown:
+            print(f"  {path.name} done", flush=True)
     head = ["example", "bosses", "plate parts", "rod links (planes)", "planes", "sheets", "pins",
             "pins without a hole", "springs", "base plate (mm)", "fixed-point holes",
             "guide slots", "stop blocks", "slots meeting a hole"]
