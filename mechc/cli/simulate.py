@@ -34,6 +34,9 @@ levels:
   dynamic    (default) pymunk rigid bodies, springs and contacts; inputs moved by bounded-force
              actuators along a Gray-code tour of every vector plus --cases seeded random
              changes; outputs at rest, glitches, settling, joint violations (solver error)
+  timing     the dynamic level's changes timed from the closed form and the cells'
+             characterised tables (no scene): each output's switching and settle time, the
+             critical path, slack; a sequential design's ordering requirements with slack
 
 Exit status 0 only if the proof holds; 1 if it fails (the failures are listed).""")
     s.add_argument("design", metavar="SPEC_OR_JSON")
@@ -110,8 +113,8 @@ def _check_options(args: argparse.Namespace) -> None:
         if args.trace_every <= 0:
             raise UsageError("--trace-every must be positive")
     if args.trace:
-        if args.level == "logic":
-            raise UsageError("--trace records body poses: the logic level has none (use "
+        if args.level in ("logic", "timing"):
+            raise UsageError(f"--trace records body poses: the {args.level} level has none (use "
                              "--level kinematic or dynamic)")
         if args.prune:
             raise UsageError("--trace records the whole scene: it cannot be taken with --prune")
@@ -169,7 +172,8 @@ def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: 
 
     def tick(done: int, total: int) -> None:
         bar.total = total
-        bar.update(done, "input changes" if args.level == "dynamic" else "states")
+        bar.update(done, {"dynamic": "input changes",
+                          "timing": "cell measurements"}.get(args.level, "states"))
 
     try:
         return prove(design, spec, lib, args.level, settings, tick)

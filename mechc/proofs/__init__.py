@@ -1,9 +1,16 @@
-"""Proofs of a design against its spec at three levels (logic, kinematic, dynamic), for
+"""Proofs of a design against its spec at four levels (logic, kinematic, dynamic, timing), for
 combinational and sequential designs: :func:`prove` runs the engine registered for the level
 and the spec's kind, with :class:`ProofSettings`, and returns a :class:`ProofReport`."""
 
 # each engine module registers its proof with mechc.proofs.registry when imported
-from mechc.proofs import dynamic, kinematic, logic, seq_logic, seq_mechanism  # noqa: F401
+from mechc.proofs import (  # noqa: F401
+    dynamic,
+    kinematic,
+    logic,
+    seq_logic,
+    seq_mechanism,
+    timing,
+)
 from mechc.proofs.registry import KINDS, LEVELS, check_interface, prove, spec_kind
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings, dyn_settings

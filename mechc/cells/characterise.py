@@ -1,0 +1,381 @@
+"""Cell characterisation: a cell's timing measured once in pymunk, kept as a small table.
+
+Electronic design times a chip from per-cell tables (delay and slew against input slew and
+load) instead of simulating it whole; this module makes those tables for mechc's cells. A cell
+(type x fan-in x parameters x stroke) is compiled alone (as :mod:`mechc.cells.prove_cell`
+does), and every single-input change that switches its output is run on its pymunk scene over
+a small grid of input move times (the input's speed) and masses added to the output body (the
+load its net drives). Per grid point, the worst change gives:
+
+- ``lag_s``: how much later the output crosses mid-stroke than the closed form (the
+  quasi-static linkage) says, the dynamic part of its switching time;
+- ``settle_extra_s``: how much later the output stays within ``SETTLED`` of its end
+  position than the closed form's output does;
+- ``overshoot``: the largest excursion beyond the end position (fraction of stroke);
+- ``force_N``: the peak inertial force on the output body (its mass with the load times its
+  peak acceleration), what the cell must deliver to switch its load at that speed.
+
+Tables are looked up by a key hashing the cell's file, its type, fan-in, parameters, stroke
+and the geometry it compiles to: the stdlib's ship with mechc (``characterised.json``,
+written by ``mechc cells characterise``), a user cell's are measured on first use and cached
+in ``$MECHC_CACHE_DIR`` (default ``$XDG_CACHE_HOME/mechc`` or ``~/.cache/mechc``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from mechc.cells.cell import Cell
+from mechc.cells.library import Library
+from mechc.ir.logic_types import evaluate_type, table_rows
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.scene import DynSettings, Scene
+
+#: Bump when what is measured or how changes: older tables are then measured again.
+VERSION = 1
+#: Input move times (s) of the grid: 2x faster and 2x slower than the proofs' default 0.08 s.
+MOVE_TIMES = (0.04, 0.08, 0.16)
+#: Masses (kg) added to the output body: none, about one load's slider and rod, about three.
+LOADS = (0.0, 0.03, 0.09)
+#: An output within this fraction of stroke of its end position has settled (the dynamic
+#: proof's own threshold, ``mechc.physics.scene.Scene.move``).
+SETTLED = 0.005
+#: Logic types a cell cannot be characterised alone for: stateful, or without inputs.
+UNTIMED = frozenset({"MEMORY", "CONST"})
+SHIPPED = Path(__file__).with_name("characterised.json")
+FIGURES = ("lag_s", "settle_extra_s", "overshoot", "force_N")
+
+#: Called as (done, total) while a cell is measured.
+OnProgress = Callable[[int, int], None]
+
+
+@dataclass
+class CellTable:
+    """One cell's timing table: ``values[figure]`` is a (move times x loads) grid."""
+
+    key: str
+    cell: str
+    type: str
+    n: int
+    params: dict
+    stroke: float
+    move_times: tuple[float, ...]
+    loads: tuple[float, ...]
+    values: dict[str, list[list[float]]]
+    changes: int  # switching changes measured per grid point
+    seconds: float = 0.0
+
+    def at(self, move_time: float, load: float) -> dict[str, float]:
+        """Every figure at ``move_time`` and ``load``, bilinear between grid points and held
+        at the grid's edge outside it (a cell is never extrapolated)."""
+        mt = np.asarray(self.move_times, dtype=float)
+        ld = np.asarray(self.loads, dtype=float)
+        x = float(np.clip(move_time, mt[0], mt[-1]))
+        y = float(np.clip(load, ld[0], ld[-1]))
+        i = int(np.clip(np.searchsorted(mt, x) - 1, 0, len(mt) - 2))
+        j = int(np.clip(np.searchsorted(ld, y) - 1, 0, len(ld) - 2))
+        fx = (x - mt[i]) / (mt[i + 1] - mt[i])
+        fy = (y - ld[j]) / (ld[j + 1] - ld[j])
+        out = {}
+        for name, grid in self.values.items():
+            g = np.asarray(grid, dtype=float)
+            out[name] = float((1 - fx) * (1 - fy) * g[i, j] + fx * (1 - fy) * g[i + 1, j]
+                              + (1 - fx) * fy * g[i, j + 1] + fx * fy * g[i + 1, j + 1])
+        return out
+
+    def to_json(self) -> dict:
+        return {"key": self.key, "cell": self.cell, "type": self.type, "n": self.n,
+                "params": self.params, "stroke": self.stroke,
+                "move_times_s": list(self.move_times), "loads_kg": list(self.loads),
+                "values": self.values, "changes": self.changes,
+                "seconds": round(self.seconds, 3)}
+
+    @staticmethod
+    def from_json(d: dict) -> CellTable:
+        return CellTable(d["key"], d["cell"], d["type"], int(d["n"]), dict(d["params"]),
+                         float(d["stroke"]), tuple(d["move_times_s"]), tuple(d["loads_kg"]),
+                         {k: [list(map(float, r)) for r in v] for k, v in d["values"].items()},
+                         int(d["changes"]), float(d.get("seconds", 0.0)))
+
+
+def cache_dir() -> Path:
+    """Where measured tables of user cells are kept (``MECHC_CACHE_DIR`` overrides)."""
+    env = os.environ.get("MECHC_CACHE_DIR")
+    if env:
+        return Path(env)
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "mechc" / "cells"
+
+
+def alone(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
+          stroke: float):
+    """The one-cell design (input sliders, the cell, output ``z``), as a cell is proven alone."""
+    # the pipeline sits above the cell layer (it imports this package): imported when used
+    from mechc.frontends.boolfile import parse_bool
+    from mechc.passes.assemble import MechOptions
+    from mechc.pipeline import CompileOptions, compile_netlist
+
+    nets = [f"i{k}" for k in range(n)]
+    table = evaluate_type(type_name, table_rows(n), params, 1 << n)
+    on = [str(r) for r in range(1 << n) if table[r]]
+    spec = parse_bool(f"inputs {' '.join(nets)}\noutputs z\n"
+                      + (f"z = minterms({', '.join(on)})\n" if on else "z = 0\n"),
+                      f"<cell {cls.name}>")
+    nl = Netlist(nets)
+    nl.add_cell(CellInst("c1", cls.name, type_name, tuple(nets), ("z",), params),
+                pin_names=cls.input_names(n), out_pins=list(cls.outputs))
+    nl.set_output("z", "z")
+    return compile_netlist(spec, nl, CompileOptions(mech=MechOptions(stroke=stroke)), lib), table
+
+
+#: Keys of a part's JSON that say where it stands, not what it is (left out of its hash).
+PLACEMENT_KEYS = frozenset({"outline", "pivot", "p0", "p1", "q", "pa", "pb", "profile", "off",
+                            "on", "at", "id", "a", "b", "body"})
+
+
+def geometry_of(part_json: dict) -> object:
+    """A part's geometry less its placement: masses, axes, lengths, springs, the cell's own
+    numbers (two instances sized alike hash alike wherever they are placed)."""
+    if isinstance(part_json, dict):
+        return {k: geometry_of(v) for k, v in sorted(part_json.items())
+                if k not in PLACEMENT_KEYS}
+    if isinstance(part_json, list):
+        return [geometry_of(v) for v in part_json]
+    if isinstance(part_json, float):
+        return round(part_json, 6)
+    return part_json
+
+
+def table_key(cls: type[Cell], type_name: str, n: int, params: dict, stroke: float,
+              part_json: dict) -> str:
+    """The hash a table is kept under: the cell's file and name, what it is asked to be, and
+    the geometry it was built with (a changed spring or lever gets a new table)."""
+    text = json.dumps({"v": VERSION, "cell": cls.name, "sha": cls.source_sha256,
+                       "type": type_name, "n": n, "params": params, "stroke": stroke,
+                       "grid": [MOVE_TIMES, LOADS], "geometry": geometry_of(part_json)},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def switching_changes(table: np.ndarray, n: int) -> list[tuple[int, int]]:
+    """(from row, to row) of every single-input change that moves the output."""
+    out = []
+    for row in range(1 << n):
+        for k in range(n):
+            to = row ^ (1 << (n - 1 - k))
+            if table[row] != table[to]:
+                out.append((row, to))
+    return out
+
+
+@dataclass
+class Move:
+    """One change a cell is timed on: the whole design's inputs at the start, the input that
+    moves and where to."""
+
+    start: dict[str, float]
+    name: str
+    target: float
+
+
+def measure(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
+            stroke: float, progress: OnProgress | None = None) -> CellTable:
+    """The cell compiled alone, timed over the grid on every change that switches it."""
+    design, truth = alone(cls, lib, type_name, n, params, stroke)
+    names = [f"i{k}" for k in range(n)]
+    moves = []
+    for row, to in switching_changes(np.asarray(truth), n):
+        k = n - (row ^ to).bit_length()
+        moves.append(Move({nm: float((row >> (n - 1 - q)) & 1) for q, nm in enumerate(names)},
+                          names[k], float((to >> (n - 1 - k)) & 1)))
+    return measure_in(design, lib, "c1", moves, progress)
+
+
+def measure_in(design, lib: Library, cid: str, moves: list[Move],
+               progress: OnProgress | None = None) -> CellTable:
+    """Cell ``cid`` of ``design`` timed over the grid: a scene of that cell alone (its input
+    rods driven along the closed form of what drives them, its output body carrying the
+    grid's load), run through ``moves``, the worst of them kept per grid point."""
+    t0 = time.perf_counter()
+    mech = design.mechanism
+    c = design.netlist.cells[cid]
+    cls = lib[c.cell]
+    part = mech.cells[cid]
+    key = table_key(cls, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke,
+                    _unprefixed(part.to_json(), cid))
+    types = {x.id: x.cell for x in design.netlist.cells.values()}
+    out_body = part.terminals[cls.outputs[0]].body
+    values = {f: [[0.0] * len(LOADS) for _ in MOVE_TIMES] for f in FIGURES}
+    total, done = len(MOVE_TIMES) * len(LOADS), 0
+    for i, mt in enumerate(MOVE_TIMES):
+        for j, load in enumerate(LOADS):
+            worst = dict.fromkeys(FIGURES, 0.0)
+            for mv in moves:
+                got = _one_change(mech, lib, types, cid, mv, mt, load, out_body,
+                                  cls.outputs[0])
+                for f in FIGURES:
+                    worst[f] = max(worst[f], got[f])
+            for f in FIGURES:
+                values[f][i][j] = round(worst[f], 6)
+            done += 1
+            if progress is not None:
+                progress(done, total)
+    return CellTable(key, c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke,
+                     MOVE_TIMES, LOADS, values, len(moves), time.perf_counter() - t0)
+
+
+def _unprefixed(part_json: dict, cid: str) -> dict:
+    """The part's JSON with its cell id taken out of body and joint names."""
+    return json.loads(json.dumps(part_json).replace(f'"{cid}.', '"'))
+
+
+def _one_change(mech, lib, types, cid: str, mv: Move, move_time: float, load: float,
+                out_body: str, out_pin: str) -> dict:
+    st = DynSettings(move_time=move_time, violation_limit=0.005 * mech.ctx.stroke)
+    sc = Scene.build(mech, lib, types, st, dict(mv.start), cells=[cid])
+    body = sc.bodies[out_body]
+    body.mass = body.mass + load
+    # the cell's output signal, read from the scene (a design's outputs are what it records)
+    key = f"__cell_{cid}"
+    mech.outputs[key] = (cid, out_pin)
+    try:
+        r = sc.move(mv.name, mv.target)
+    finally:
+        del mech.outputs[key]
+    out, ref, t = r.outputs[key], r.reference[key], r.t
+    t = np.concatenate([[0.0], t])
+    out, ref = np.concatenate([[out[0]], out]), np.concatenate([[ref[0]], ref])
+    lag = crossing(t, out) - crossing(t, ref)
+    extra = settled_at(t, out) - settled_at(t, ref)
+    end = out[-1]
+    direction = 1.0 if ref[-1] >= ref[0] else -1.0
+    over = max(0.0, float(np.max(direction * (out - end))))
+    u = out * mech.ctx.stroke  # mm
+    acc = np.gradient(np.gradient(u, t), t)  # mm / s^2
+    force = body.mass * float(np.max(np.abs(acc))) / 1000.0  # kg mm/s^2 -> N
+    return {"lag_s": lag if math.isfinite(lag) else 0.0,
+            "settle_extra_s": extra if math.isfinite(extra) else 0.0,
+            "overshoot": over, "force_N": force}
+
+
+def crossing(t: np.ndarray, x: np.ndarray, level: float = 0.5) -> float:
+    """First time ``x`` crosses ``level`` (linear between samples; nan if it never does)."""
+    s = np.sign(np.asarray(x) - level)
+    idx = np.flatnonzero(s[1:] != s[:-1])
+    if not len(idx):
+        return math.nan
+    i = int(idx[0])
+    x0, x1 = x[i], x[i + 1]
+    f = 0.0 if x1 == x0 else (level - x0) / (x1 - x0)
+    return float(t[i] + f * (t[i + 1] - t[i]))
+
+
+def settled_at(t: np.ndarray, x: np.ndarray, end: float | None = None,
+               within: float = SETTLED) -> float:
+    """The time from which ``x`` stays within ``within`` of ``end`` (default its last
+    value), linear between the last sample outside and the next one."""
+    x = np.asarray(x)
+    e = float(x[-1]) if end is None else end
+    out = np.flatnonzero(np.abs(x - e) > within)
+    if not len(out):
+        return float(t[0])
+    i = int(out[-1])
+    if i + 1 >= len(t):
+        return float(t[-1])
+    d0, d1 = abs(x[i] - e), abs(x[i + 1] - e)
+    f = 1.0 if d0 == d1 else (d0 - within) / (d0 - d1)
+    return float(t[i] + min(max(f, 0.0), 1.0) * (t[i + 1] - t[i]))
+
+
+class Tables:
+    """The tables a design's cells need, by the hash of each cell's geometry: shipped with
+    mechc, cached on disk, or measured now (in the design, on the moves given)."""
+
+    def __init__(self, lib: Library, progress: Callable[[str, int, int], None] | None = None,
+                 cache: Path | None = None):
+        self.lib = lib
+        self.progress = progress
+        self.cache = cache or cache_dir()
+        self.shipped = {d["key"]: d for d in _read_shipped()}
+        self._mem: dict[str, CellTable] = {}
+        self.measured: list[str] = []
+        self.found = {"shipped": 0, "cached": 0, "measured": 0}
+
+    def key_of(self, design, cid: str) -> str:
+        c = design.netlist.cells[cid]
+        return table_key(self.lib[c.cell], c.type, len(c.inputs), dict(c.params),
+                         design.mechanism.ctx.stroke,
+                         _unprefixed(design.mechanism.cells[cid].to_json(), cid))
+
+    def get(self, design, cid: str, moves: Callable[[], list[Move]]) -> CellTable | None:
+        """The table of cell ``cid``; None for a cell not timed alone (stateful, constant)
+        or one that no move switches. ``moves`` gives the changes to measure it on."""
+        c = design.netlist.cells[cid]
+        cls = self.lib[c.cell]
+        if cls.stateful or c.type in UNTIMED:
+            return None
+        key = self.key_of(design, cid)
+        if key in self._mem:
+            return self._mem[key]
+        if key in self.shipped:
+            tab = CellTable.from_json(self.shipped[key])
+            self._mem[key] = tab
+            self.found["shipped"] += 1
+            return tab
+        path = self.cache / f"{c.cell}-{key}.json"
+        if path.exists():
+            try:
+                tab = CellTable.from_json(json.loads(path.read_text()))
+                self._mem[key] = tab
+                self.found["cached"] += 1
+                return tab
+            except (OSError, ValueError, KeyError):
+                pass  # a damaged cache entry is measured again
+        mv = moves()
+        if not mv:
+            return None
+        say = self.progress
+        tab = measure_in(design, self.lib, cid, mv,
+                         None if say is None else (lambda d, t: say(cid, d, t)))
+        self.measured.append(cid)
+        self.found["measured"] += 1
+        try:
+            self.cache.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(tab.to_json()))
+        except OSError:
+            pass  # an unwritable cache costs a measurement next time, nothing else
+        self._mem[key] = tab
+        return tab
+
+
+def _read_shipped() -> list[dict]:
+    if not SHIPPED.exists():
+        return []
+    return json.loads(SHIPPED.read_text())["tables"]
+
+
+#: The stdlib cells shipped with tables: (cell, logic type, fan-in), default parameters.
+STANDARD = [("and", "AND", 2), ("and", "AND", 3), ("or", "OR", 2), ("or", "OR", 3),
+            ("nand", "NAND", 2), ("nor", "NOR", 2), ("and_not", "AND_NOT", 2),
+            ("or_not", "OR_NOT", 2), ("not", "NOT", 1), ("xor", "XOR", 2)]
+
+
+def characterise_standard(lib: Library, stroke: float = 20.0,
+                          say: Callable[[str], None] | None = None) -> dict:
+    """The shipped file's content: every ``STANDARD`` cell measured at ``stroke``."""
+    tables = []
+    for cell, type_name, n in STANDARD:
+        tab = measure(lib[cell], lib, type_name, n, {}, stroke)
+        tables.append(tab.to_json())
+        if say is not None:
+            say(f"{cell} {type_name}/{n}: {tab.changes} changes, {tab.seconds:.1f} s")
+    return {"format": "mechc-cell-timing", "version": VERSION, "tables": tables}

@@ -1,0 +1,394 @@
+"""Timing level: every input change's switching and settle times from the closed form and
+the cells' characterised tables (:mod:`mechc.cells.characterise`), without a pymunk scene.
+
+A linkage is quasi-static to first order: where an output stands at each instant of an input's
+move is what the closed form says for the input's position then. So per change (the dynamic
+proof's own plan) the whole mechanism's closed form is evaluated along the move, and each
+sample's time is where the minimum-jerk profile puts that input position. On top, each cell
+on the switching path adds what its table says the dynamics add at its input speed and the
+mass its output net drives: the lag of its mid-stroke crossing, and (the last cell) how much
+later it settles. Path delays are the longest sum through the cells whose output switches
+(static timing analysis over the netlist's DAG).
+
+Per change and switching output: ``switch_s`` (the output crosses mid-stroke) and
+``settle_s`` (it stays within 0.5 % of stroke of its end), both from the start of the input's
+move; the slack of a change is the time the dynamic proof allows (the move and the hold)
+less the latest settle. The critical path is the change, output and cells of the latest
+settle. A sequential design's ordering requirements (S·R overlap, essential hazards; found at
+compile, ``mechc.passes.ordering``) become timing inequalities with the cells' characterised
+delays in place of their stated ones, each with its slack.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import networkx as nx
+import numpy as np
+
+from mechc.cells.characterise import SETTLED, CellTable, Move, Tables, crossing, settled_at
+from mechc.cells.library import Library
+from mechc.ir.design import Design
+from mechc.ir.netlist import Netlist
+from mechc.ir.seqspec import SeqSpec
+from mechc.ir.spec import Spec
+from mechc.parts.pushrod import net_rods
+from mechc.physics.evaluate import evaluate, output_signals
+from mechc.physics.scene import DynSettings, min_jerk
+from mechc.proofs.dynamic import plan
+from mechc.proofs.kinematic import prove_kinematic
+from mechc.proofs.registry import OnProgress, engine
+from mechc.proofs.report import ProofReport
+from mechc.proofs.settings import MEMORY_THROW_S, ProofSettings, dyn_settings
+
+#: Closed-form samples along each input move.
+SAMPLES = 81
+#: Changes evaluated in one closed-form call (bounds memory on big designs).
+CHUNK = 64
+#: Per-change records kept in the report.
+MAX_CHANGES_LISTED = 200
+#: An ordering inequality must hold by this (s), as at compile (``mechc.passes.ordering``).
+MARGIN_S = 0.02
+
+
+def sample_times(move_time: float, k: int = SAMPLES) -> np.ndarray:
+    """The time (s) at which a minimum-jerk move passes each of ``k`` evenly spaced
+    positions (the inverse of :func:`mechc.physics.scene.min_jerk`, by interpolation)."""
+    tau = np.linspace(0.0, 1.0, 4001)
+    return move_time * np.interp(np.linspace(0.0, 1.0, k), min_jerk(tau), tau)
+
+
+def net_loads(design: Design) -> dict[str, float]:
+    """Mass (kg) each net's driver moves besides its own output: the net's rods and its
+    loads' input sliders."""
+    mech = design.mechanism
+    index = mech.body_index()
+    out: dict[str, float] = {}
+    for net, part in mech.nets.items():
+        m = 0.0
+        for r in net_rods(part):
+            if r.body is not None and r.body in index:
+                m += index[r.body].mass
+            if r.load in index:
+                m += index[r.load].mass
+        out[net] = m
+    return out
+
+
+def cell_tables(design: Design, lib: Library, names: list[str],
+                changes: list[tuple[int, int]], progress: OnProgress | None
+                ) -> tuple[dict[str, CellTable | None], Tables]:
+    """Each cell's table, shipped or cached by its geometry's hash, else measured now in the
+    design (a scene of the cell alone) on the first change that switches it on and the first
+    that switches it off (``progress`` told the grid points measured)."""
+    nl = design.netlist
+    n = len(names)
+    cells = nl.topo_cells()
+    per = None
+
+    def moves_of(cid: str) -> list[Move]:
+        nonlocal per
+        if per is None:
+            per = _switches(nl, names, changes)
+        out = []
+        for cur, vec in per.get(cid, []):
+            k = n - (cur ^ vec).bit_length()
+            out.append(Move({nm: float((cur >> (n - 1 - q)) & 1) for q, nm in enumerate(names)},
+                            names[k], float((vec >> (n - 1 - k)) & 1)))
+        return out
+
+    def tick(_cid: str, done: int, total: int) -> None:
+        if progress is not None:
+            progress(done, total)
+
+    tabs = Tables(lib, tick)
+    out = {c.id: tabs.get(design, c.id, lambda cid=c.id: moves_of(cid)) for c in cells}
+    return out, tabs
+
+
+def _switches(nl: Netlist, names: list[str], changes: list[tuple[int, int]]
+              ) -> dict[str, list[tuple[int, int]]]:
+    """Per cell: the first change of ``changes`` that switches its output on and the first
+    that switches it off."""
+    n = len(names)
+    if not changes or nl.state_nets():
+        return {}
+    logic = nl.evaluate({nm: np.array([[(v >> (n - 1 - k)) & 1 for v in pair]
+                                       for pair in changes], dtype=bool).ravel()
+                         for k, nm in enumerate(names)})
+    out: dict[str, list[tuple[int, int]]] = {}
+    for c in nl.cells.values():
+        v = logic.get(c.outputs[0])
+        if v is None:
+            continue
+        v = np.asarray(v).reshape(-1, 2)
+        for want in (True, False):
+            hit = np.flatnonzero((v[:, 0] != v[:, 1]) & (v[:, 1] == want))
+            if len(hit):
+                out.setdefault(c.id, []).append(changes[int(hit[0])])
+    return out
+
+
+@engine("timing", "combinational")
+def timing_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
+                  progress: OnProgress | None) -> ProofReport:
+    return prove_timing(design, spec, lib, settings, progress)
+
+
+def prove_timing(design: Design, spec: Spec, lib: Library,
+                 settings: ProofSettings | None = None,
+                 progress: OnProgress | None = None) -> ProofReport:
+    """The timing proof of a combinational design (see the module docstring)."""
+    t0 = time.perf_counter()
+    settings = settings or ProofSettings()
+    kin = prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed)
+    st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time)
+    names = list(spec.inputs)
+    n = len(names)
+    vectors = plan(n, settings.cases, settings.seed)
+    changes = list(zip([0, *vectors], vectors))
+    tables, tabs = cell_tables(design, lib, names, changes, progress)
+    timed = predict_changes(design, lib, names, changes, st, tables)
+    budget = st.move_time + st.settle_time
+    failures: list[dict] = []
+    for f in kin.failures:
+        failures.append({**f, "kind": f"kinematic {f.get('kind', '')}".strip()})
+    crit = None
+    late = 0
+    for ch in timed:
+        ch["slack_s"] = round(budget - ch["settle_s"], 5)
+        if ch["slack_s"] < 0:
+            late += 1
+            if len(failures) < 50:
+                failures.append({"kind": "settle", "inputs": ch["inputs"],
+                                 "moving": ch["moving"], "to": ch["to"],
+                                 "message": f"predicted to settle {ch['settle_s']:.4f} s after "
+                                 f"the move starts (allowed {budget:.3f} s)"})
+        if crit is None or ch["settle_s"] > crit["settle_s"]:
+            crit = ch
+    kinds = {}
+    if kin.failure_count:
+        kinds["kinematic"] = kin.failure_count
+    if late:
+        kinds["settle"] = late
+    fails = kin.failure_count + late
+    crit_json = None
+    if crit is not None and crit["outputs"]:
+        o = max(crit["outputs"], key=lambda k: crit["outputs"][k]["settle_s"])
+        crit_json = {"inputs": crit["inputs"], "moving": crit["moving"], "to": crit["to"],
+                     "output": o, **crit["outputs"][o]}
+    slacks = [c["slack_s"] for c in timed]
+    measured = sorted(set(tabs.measured))
+    return ProofReport(
+        level="timing", kind="combinational", passed=fails == 0, cases=len(timed),
+        coverage={"random_changes": settings.cases, "seed": settings.seed,
+                  "tolerance_fraction": settings.tolerance},
+        failure_count=fails, failure_kinds=kinds or None, failures=failures,
+        figures={
+            "max_settle_time_s": round(max(0.0, (crit or {"settle_s": 0.0})["settle_s"]
+                                           - st.move_time), 5),
+            "max_deviation_fraction": kin.figures.get("max_deviation_fraction"),
+            "min_transmission_angle_deg": kin.figures.get("min_transmission_angle_deg"),
+            "min_slack_s": round(min(slacks), 5) if slacks else None,
+            "critical_path": crit_json,
+            "budget_s": round(budget, 5),
+            "move_time_s": st.move_time,
+            "cell_tables": {"cells": len(tables), **tabs.found,
+                            "untimed": sorted(k for k, v in tables.items() if v is None),
+                            "measured_now": measured},
+            "changes": timed[:MAX_CHANGES_LISTED],
+        },
+        seconds=round(time.perf_counter() - t0, 4))
+
+
+def predict_changes(design: Design, lib: Library, names: list[str],
+                    changes: list[tuple[int, int]], st: DynSettings,
+                    tables: dict[str, CellTable | None]) -> list[dict]:
+    """Per change (from input vector, to input vector; one input differs): its switching
+    outputs' predicted ``switch_s``, ``settle_s`` and the path of cells that sets them."""
+    mech, nl = design.mechanism, design.netlist
+    types = {c.id: c.cell for c in nl.cells.values()}
+    n = len(names)
+    ts = sample_times(st.move_time)
+    loads = net_loads(design)
+    driver = {c.outputs[0]: c for c in nl.cells.values()}
+    figs = {cid: (tab.at(st.move_time, loads.get(nl.cells[cid].outputs[0], 0.0))
+                  if tab is not None else None) for cid, tab in tables.items()}
+    out: list[dict] = []
+    frac = np.linspace(0.0, 1.0, SAMPLES)
+    for lo in range(0, len(changes), CHUNK):
+        chunk = changes[lo:lo + CHUNK]
+        vals = {}
+        for k, nm in enumerate(names):
+            cols = []
+            for cur, vec in chunk:
+                a = (cur >> (n - 1 - k)) & 1
+                b = (vec >> (n - 1 - k)) & 1
+                cols.append(a + (b - a) * frac)
+            vals[nm] = np.concatenate(cols)
+        sig = output_signals(mech, evaluate(mech, lib, types, vals))
+        logic = nl.evaluate({nm: np.array([[(v >> (n - 1 - k)) & 1 for v in pair]
+                                           for pair in chunk], dtype=bool).ravel()
+                             for k, nm in enumerate(names)})
+        for i, (cur, vec) in enumerate(chunk):
+            k = n - (cur ^ vec).bit_length()
+            moving = names[k]
+            switched = {net for net, v in logic.items() if v[2 * i] != v[2 * i + 1]}
+            arrive, settle, path = _paths(nl, "in:" + moving, switched, figs)
+            rec = {"inputs": _vec(vec, names), "moving": moving,
+                   "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
+            for o, net in nl.outputs.items():
+                if net not in switched or o not in sig:
+                    continue
+                s = sig[o][i * SAMPLES:(i + 1) * SAMPLES]
+                cf_cross = crossing(ts, s)
+                cf_settle = settled_at(ts, s, end=float(s[-1]), within=SETTLED)
+                if not math.isfinite(cf_cross):
+                    cf_cross = ts[-1]
+                cid = driver[net].id if net in driver else None
+                lag = arrive.get(net, 0.0)
+                extra = settle.get(net, 0.0)
+                rec["outputs"][o] = {"switch_s": round(cf_cross + lag, 6),
+                                     "settle_s": round(cf_settle + extra, 6),
+                                     "closed_form_switch_s": round(cf_cross, 6),
+                                     "closed_form_settle_s": round(cf_settle, 6),
+                                     "path": path.get(net, [cid] if cid else [])}
+                rec["settle_s"] = max(rec["settle_s"], rec["outputs"][o]["settle_s"])
+            out.append(rec)
+    return out
+
+
+def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | None]
+           ) -> tuple[dict[str, float], dict[str, float], dict[str, list[str]]]:
+    """Per switched net: the longest sum of the switching cells' lags from ``source`` (the
+    arrival of its mid-stroke crossing beyond the closed form's), the settle delay (the
+    upstream lags plus the driving cell's own settle extra, or a late-settling input's delay
+    passed on) and the cells on the longest path."""
+    arrive: dict[str, float] = {source[3:]: 0.0}
+    settle: dict[str, float] = {}
+    path: dict[str, list[str]] = {source[3:]: []}
+    for c in nl.topo_cells():
+        net = c.outputs[0]
+        if net not in switched:
+            continue
+        came = [(arrive[x], x) for x in c.inputs if x in arrive]
+        if not came:
+            continue
+        a, via = max(came)
+        f = figs.get(c.id) or {"lag_s": 0.0, "settle_extra_s": 0.0}
+        arrive[net] = a + f["lag_s"]
+        # an output follows its inputs: a late-settling input settles it late too
+        late = max((settle[x] for x in c.inputs if x in settle), default=0.0)
+        settle[net] = max(a + f["settle_extra_s"], late + f["lag_s"])
+        path[net] = [*path[via], c.id]
+    return arrive, settle, path
+
+
+def _vec(row: int, names: list[str]) -> dict[str, int]:
+    n = len(names)
+    return {nm: int((row >> (n - 1 - k)) & 1) for k, nm in enumerate(names)}
+
+
+# ---- sequential: the ordering requirements as timing inequalities ---------------------------
+@engine("timing", "sequential")
+def seq_timing_engine(design: Design, spec: SeqSpec, lib: Library, settings: ProofSettings,
+                      progress: OnProgress | None) -> ProofReport:
+    """Every ordering requirement recorded at compile, its inequality evaluated with the
+    cells' characterised delays (a gate's lag at its load; an AMPLIFIER's or any cell without
+    a table, its stated ``switching_delay_s``)."""
+    t0 = time.perf_counter()
+    tables, _tabs = cell_tables(design, lib, [], [], progress)
+    st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time)
+    nl = design.netlist
+    loads = net_loads(design)
+    delay = {}
+    for c in nl.cells.values():
+        tab = tables.get(c.id)
+        stated = float(getattr(lib[c.cell], "switching_delay_s", 0.0))
+        delay[c.id] = (max(stated, tab.at(st.move_time, loads.get(c.outputs[0], 0.0))["lag_s"])
+                       if tab is not None else stated)
+    reqs = ((design.stats.get("sequential") or {}).get("ordering") or {}).get("requirements",
+                                                                            [])
+    found = []
+    failures = []
+    for r in reqs:
+        ineq = inequality(nl, delay, r, st.move_time)
+        found.append({"kind": r["kind"], "input": r["input"], "memories": r["memories"],
+                      "requires": r["requires"], **ineq})
+        if not ineq["met"] and len(failures) < 50:
+            failures.append({"kind": "ordering", "message": f"{r['kind']}: {ineq['text']}"})
+    slacks = [f["slack_s"] for f in found]
+    return ProofReport(
+        level="timing", kind="sequential", passed=not failures, cases=len(found),
+        coverage={"requirements": len(found)}, failure_count=len(failures),
+        failure_kinds={"ordering": len(failures)} if failures else None, failures=failures,
+        figures={"min_slack_s": round(min(slacks), 5) if slacks else None,
+                 "requirements": found, "move_time_s": st.move_time,
+                 "cell_delays_s": {k: round(v, 6) for k, v in sorted(delay.items())}},
+        seconds=round(time.perf_counter() - t0, 4))
+
+
+def inequality(nl: Netlist, delay: dict[str, float], req: dict, move_time: float) -> dict:
+    """One requirement as an inequality with its slack: for an essential hazard, the moving
+    input must reach every SET/RESET generator (longest path) before a switching memory's
+    new state does and comes back (shortest path, the memory's throw); for SET and RESET
+    moving together, the skew between the input's paths to the two pins must stay within
+    the margin."""
+    g = nl.combinational_graph()
+    sr: dict[str, set[str]] = {}
+    for u, v in nl.graph.edges():
+        if v in nl.cells and nl.cells[v].type == "MEMORY":
+            sr.setdefault(v, set()).add(u)
+    mem_of = {c.outputs[0]: c.id for c in nl.cells.values() if c.type == "MEMORY"}
+    src = "in:" + req["input"]
+    far = _sum_paths(g, delay, [*g.successors(src)], max)
+    near = _sum_paths(g, delay, [*g.successors(src)], min)
+    if req["kind"] == "set-reset-together":
+        skew = 0.0
+        for net in req["memories"]:
+            drivers = [u for u in sr.get(mem_of.get(net, ""), ()) if u in far]
+            if len(drivers) == 2:
+                a, b = drivers
+                skew = max(skew, far[a] - near[b], far[b] - near[a])
+        slack = MARGIN_S - skew
+        return {"skew_s": round(skew, 5), "slack_s": round(slack, 5), "met": slack >= 0,
+                "text": f"skew {skew:.4f} s <= margin {MARGIN_S:.3f} s (slack {slack:+.4f} s)"}
+    t_in = move_time + max((far[u] for d in sr.values() for u in d if u in far), default=0.0)
+    t_mem = math.inf
+    for net in req["memories"]:
+        cid = mem_of.get(net)
+        if cid is None:
+            continue
+        start = move_time / 2 + min((near[u] for u in sr.get(cid, ()) if u in near),
+                                    default=0.0)
+        back = _sum_paths(g, delay, sorted(set(nl.graph.successors(cid))), min)
+        fb = min((back[u] for d in sr.values() for u in d if u in back and u != cid),
+                 default=0.0)
+        t_mem = min(t_mem, start + MEMORY_THROW_S + fb)
+    if not math.isfinite(t_mem):
+        t_mem = move_time / 2 + MEMORY_THROW_S
+    slack = t_mem - t_in - MARGIN_S
+    return {"t_input_s": round(t_in, 5), "t_memory_feedback_s": round(t_mem, 5),
+            "slack_s": round(slack, 5), "met": slack >= 0,
+            "text": f"t_memory {t_mem:.4f} s - t_input {t_in:.4f} s >= margin {MARGIN_S:.3f} s "
+                    f"(slack {slack:+.4f} s)"}
+
+
+def _sum_paths(g: nx.MultiDiGraph, delay: dict[str, float], starts: list[str], pick
+               ) -> dict[str, float]:
+    """Longest (``pick=max``) or shortest (``min``) sum of cell delays from the nodes
+    ``starts`` (their own delay included) to every node they reach in the acyclic graph."""
+    reach = set(starts)
+    for v in starts:
+        reach |= nx.descendants(g, v)
+    best: dict[str, float] = {}
+    for node in nx.topological_sort(g.subgraph(reach)):
+        came = [best[u] for u in g.predecessors(node) if u in best]
+        if node in starts:
+            came.append(0.0)
+        if came:
+            best[node] = pick(came) + delay.get(node, 0.0)
+    return best

@@ -1,0 +1,186 @@
+"""Cell characterisation (``mechc.cells.characterise``) and the timing level
+(``mechc.proofs.timing``): interpolation and time measures against closed forms, tables keyed
+by geometry and cached on disk, the shipped tables reproduced by a new measurement, and the
+timing level's predictions against the whole-scene pymunk run of the same changes."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from mechc.cells import characterise as ch
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.frontends.fsm import parse_fsm_file
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.physics.scene import Scene, min_jerk
+from mechc.pipeline import compile_netlist, compile_spec
+from mechc.proofs import ProofSettings, prove
+from mechc.proofs.dynamic import plan
+from mechc.proofs.settings import dyn_settings
+from mechc.proofs.timing import cell_tables, inequality, predict_changes, sample_times
+from tests.helpers import EXAMPLES
+
+LIB = load_library()
+
+
+@pytest.fixture(scope="module")
+def full_adder():
+    return compile_spec(load_spec(EXAMPLES / "full_adder.bool"))
+
+
+def _table(values) -> ch.CellTable:
+    return ch.CellTable("k", "and", "AND", 2, {}, 20.0, (0.04, 0.08, 0.16), (0.0, 0.03, 0.09),
+                        values, 4)
+
+
+def test_table_is_bilinear_and_held_at_its_edges():
+    mt, ld = np.meshgrid([0.04, 0.08, 0.16], [0.0, 0.03, 0.09], indexing="ij")
+    f = 2.0 * mt + 5.0 * ld + 1.0  # a plane: bilinear interpolation is exact on it
+    tab = _table({"lag_s": f.tolist()})
+    for x, y in ((0.05, 0.01), (0.1, 0.06), (0.16, 0.0), (0.04, 0.09)):
+        assert tab.at(x, y)["lag_s"] == pytest.approx(2 * x + 5 * y + 1, rel=1e-12)
+    # outside the grid: the edge's value, never an extrapolation
+    assert tab.at(1.0, 5.0)["lag_s"] == pytest.approx(2 * 0.16 + 5 * 0.09 + 1)
+    assert tab.at(0.0, -1.0)["lag_s"] == pytest.approx(2 * 0.04 + 1)
+    assert ch.CellTable.from_json(json.loads(json.dumps(tab.to_json()))).at(0.1, 0.06) == \
+        tab.at(0.1, 0.06)
+
+
+def test_crossing_and_settled_on_closed_forms():
+    t = np.linspace(0.0, 1.0, 1001)
+    ramp = np.clip(t / 0.8, 0.0, 1.0)  # reaches 0.5 at 0.4 s, within 0.005 of 1 at 0.796 s
+    assert ch.crossing(t, ramp) == pytest.approx(0.4, abs=1e-9)
+    assert ch.settled_at(t, ramp) == pytest.approx(0.8 * 0.995, abs=1e-9)
+    decay = 1.0 - np.exp(-t / 0.05)  # settles within 0.005 at 0.05 ln 200
+    assert ch.settled_at(t, decay, end=1.0) == pytest.approx(0.05 * np.log(200), abs=1e-4)
+    assert np.isnan(ch.crossing(t, np.zeros_like(t)))
+
+
+def test_sample_times_invert_the_minimum_jerk_move():
+    ts = sample_times(0.08, 41)
+    assert ts[0] == 0.0 and ts[-1] == pytest.approx(0.08)
+    assert min_jerk(ts / 0.08) == pytest.approx(np.linspace(0.0, 1.0, 41), abs=1e-6)
+
+
+def test_geometry_key_ignores_placement_and_sees_a_spring():
+    d, _ = ch.alone(LIB["and"], LIB, "AND", 2, {}, 20.0)
+    part = d.mechanism.cells["c1"].to_json()
+    moved = json.loads(json.dumps(part))
+    for b in moved["bodies"]:  # the same cell placed 100 mm to the right
+        b["outline"] = [[[x + 100.0, y] for x, y in poly] for poly in b["outline"]]
+    key = ch.table_key(LIB["and"], "AND", 2, {}, 20.0, part)
+    assert ch.table_key(LIB["and"], "AND", 2, {}, 20.0, moved) == key
+    stiffer = json.loads(json.dumps(part))
+    stiffer["springs"][0]["rate_N_per_mm"] *= 2
+    assert ch.table_key(LIB["and"], "AND", 2, {}, 20.0, stiffer) != key
+    assert ch.table_key(LIB["and"], "AND", 2, {}, 25.0, part) != key
+
+
+def test_shipped_table_is_what_a_new_measurement_gives():
+    """The package's table of the NOT cell is reproduced by measuring it now (same key, same
+    figures): the shipped file is what ``mechc cells characterise`` writes."""
+    shipped = {d["key"]: d for d in json.loads(ch.SHIPPED.read_text())["tables"]}
+    tab = ch.measure(LIB["not"], LIB, "NOT", 1, {}, 20.0)
+    assert tab.key in shipped
+    for f in ch.FIGURES:
+        assert np.allclose(shipped[tab.key]["values"][f], tab.values[f], rtol=1e-3,
+                           atol=1e-6), f
+    # physics, not noise: a heavier load never makes the cell faster at the fastest move
+    force = np.array(tab.values["force_N"])
+    assert np.all(np.diff(force[0]) > 0)
+
+
+def test_cell_not_shipped_is_measured_once_then_read_from_the_cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("MECHC_CACHE_DIR", str(tmp_path))
+    nl = Netlist(["a", "b", "c", "d"])
+    nl.add_cell(CellInst("g", "and", "AND", ("a", "b", "c", "d"), ("z",)),
+                pin_names=LIB["and"].input_names(4))
+    nl.set_output("z", "z")
+    spec = load_spec_text("inputs a b c d\noutputs z\nz = a & b & c & d\n")
+    d = compile_netlist(spec, nl, library=LIB)
+    names = list(spec.inputs)
+    changes = list(zip([0, *plan(4, 0, 0)], plan(4, 0, 0)))
+    seen: list[tuple[int, int]] = []
+    first, tabs = cell_tables(d, LIB, names, changes, lambda a, b: seen.append((a, b)))
+    assert tabs.found == {"shipped": 0, "cached": 0, "measured": 1}
+    assert seen[-1] == (9, 9) and len(list(tmp_path.iterdir())) == 1  # progress, one file
+    again, tabs2 = cell_tables(d, LIB, names, changes, None)
+    assert tabs2.found == {"shipped": 0, "cached": 1, "measured": 0}
+    assert again["g"].values == first["g"].values
+
+
+def load_spec_text(text: str):
+    from mechc.frontends.boolfile import parse_bool
+
+    return parse_bool(text, "<test>")
+
+
+def test_timing_level_predicts_the_whole_scene(full_adder):
+    """Per switching output, the predicted settle and switching times are within 15 % of the
+    whole mechanism run in pymunk from rest (what the dynamic proof runs)."""
+    names = list(full_adder.spec.inputs)
+    vectors = plan(len(names), 16, 0)[:5]
+    changes = list(zip([0, *vectors], vectors))
+    st = dyn_settings(full_adder)
+    tables, _ = cell_tables(full_adder, LIB, names, changes, None)
+    pred = predict_changes(full_adder, LIB, names, changes, st, tables)
+    types = {c.id: c.cell for c in full_adder.netlist.cells.values()}
+    n = len(names)
+    checked = 0
+    for (cur, vec), p in zip(changes, pred):
+        start = {nm: float((cur >> (n - 1 - k)) & 1) for k, nm in enumerate(names)}
+        k = n - (cur ^ vec).bit_length()
+        sc = Scene.build(full_adder.mechanism, LIB, types, st, start)
+        r = sc.move(names[k], float((vec >> (n - 1 - k)) & 1))
+        t = np.concatenate([[0.0], r.t])
+        assert p["outputs"], "every change of the full adder's tour switches an output"
+        for o, po in p["outputs"].items():
+            s = np.concatenate([[r.outputs[o][0]], r.outputs[o]])
+            assert po["settle_s"] == pytest.approx(ch.settled_at(t, s), rel=0.15)
+            assert po["switch_s"] == pytest.approx(ch.crossing(t, s), rel=0.15)
+            checked += 1
+    assert checked >= 5
+
+
+def test_timing_level_report(full_adder):
+    r = prove(full_adder, full_adder.spec, LIB, "timing", ProofSettings())
+    assert r.passed and r.level == "timing"
+    assert r.cases == len(plan(3, 16, 0))
+    crit = r["critical_path"]
+    assert crit["settle_s"] == max(c["settle_s"] for c in r["changes"])
+    assert crit["path"] and all(c in full_adder.netlist.cells for c in crit["path"])
+    assert r["min_slack_s"] == pytest.approx(r["budget_s"] - crit["settle_s"], abs=1e-5)
+
+
+def test_sequential_requirements_with_stated_delays_are_the_compile_inequalities():
+    """With each cell's stated delay, the timing level's inequality is the one compile wrote
+    (``mechc.passes.ordering``), a second implementation of the same formula."""
+    d = compile_spec(parse_fsm_file(EXAMPLES / "speedctl.fsm"))
+    reqs = d.stats["sequential"]["ordering"]["requirements"]
+    assert reqs
+    stated = {c.id: float(getattr(LIB[c.cell], "switching_delay_s", 0.0))
+              for c in d.netlist.cells.values()}
+    st = dyn_settings(d, LIB)
+    for req in reqs:
+        mine = inequality(d.netlist, stated, req, st.move_time)
+        theirs = req["timing"]
+        for k in ("t_input_s", "t_memory_feedback_s", "skew_s"):
+            if k in theirs:
+                assert mine[k] == pytest.approx(theirs[k], abs=1e-4), k
+        assert mine["slack_s"] == pytest.approx(theirs.get("slack_s", 0.0) - 0.02
+                                                if "slack_s" in theirs
+                                                else 0.02 - theirs["skew_s"], abs=1e-4)
+    r = prove(d, d.spec, LIB, "timing", ProofSettings())
+    assert r.cases == len(reqs)
+    assert all("slack_s" in q for q in r["requirements"])
+
+
+def test_cli_timing_level(cli):
+    code, out, _err = cli("simulate", str(EXAMPLES / "sorter.bool"), "--level", "timing")
+    assert code == 0 and "PASSED: level timing" in out
+    code, _out, err = cli("simulate", str(EXAMPLES / "sorter.bool"), "--level", "timing",
+                          "--trace", "/tmp/never.json")
+    assert code == 2 and "timing level has none" in err
