@@ -73,6 +73,7 @@ class CellTable:
     values: dict[str, list[list[float]]]
     changes: int  # switching changes measured per grid point
     seconds: float = 0.0
+    sha: str = ""  # the cell file's SHA-256 when it was measured
 
     def at(self, move_time: float, load: float) -> dict[str, float]:
         """Every figure at ``move_time`` and ``load``, bilinear between grid points and held
@@ -97,14 +98,15 @@ class CellTable:
                 "params": self.params, "stroke": self.stroke,
                 "move_times_s": list(self.move_times), "loads_kg": list(self.loads),
                 "values": self.values, "changes": self.changes,
-                "seconds": round(self.seconds, 3)}
+                "seconds": round(self.seconds, 3), "source_sha256": self.sha}
 
     @staticmethod
     def from_json(d: dict) -> CellTable:
         return CellTable(d["key"], d["cell"], d["type"], int(d["n"]), dict(d["params"]),
                          float(d["stroke"]), tuple(d["move_times_s"]), tuple(d["loads_kg"]),
                          {k: [list(map(float, r)) for r in v] for k, v in d["values"].items()},
-                         int(d["changes"]), float(d.get("seconds", 0.0)))
+                         int(d["changes"]), float(d.get("seconds", 0.0)),
+                         d.get("source_sha256", ""))
 
 
 def cache_dir() -> Path:
@@ -202,9 +204,9 @@ def measure(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
 
 def measure_in(design, lib: Library, cid: str, moves: list[Move],
                progress: OnProgress | None = None) -> CellTable:
-    """Cell ``cid`` of ``design`` timed over the grid: a scene of that cell alone (its input
-    rods driven along the closed form of what drives them, its output body carrying the
-    grid's load), run through ``moves``, the worst of them kept per grid point."""
+    """Cell ``cid`` of ``design`` timed over the grid: a scene of that cell alone (its output
+    body carrying the grid's load), run through ``moves``, the worst of them kept per grid
+    point."""
     t0 = time.perf_counter()
     mech = design.mechanism
     c = design.netlist.cells[cid]
@@ -230,7 +232,8 @@ def measure_in(design, lib: Library, cid: str, moves: list[Move],
             if progress is not None:
                 progress(done, total)
     return CellTable(key, c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke,
-                     MOVE_TIMES, LOADS, values, len(moves), time.perf_counter() - t0)
+                     MOVE_TIMES, LOADS, values, len(moves), time.perf_counter() - t0,
+                     cls.source_sha256)
 
 
 def _unprefixed(part_json: dict, cid: str) -> dict:
@@ -297,63 +300,59 @@ def settled_at(t: np.ndarray, x: np.ndarray, end: float | None = None,
 
 
 class Tables:
-    """The tables a design's cells need, by the hash of each cell's geometry: shipped with
-    mechc, cached on disk, or measured now (in the design, on the moves given)."""
+    """The tables a design's cells need: shipped with mechc (a stdlib cell whose file is
+    the one measured), cached on disk, or measured now with the cell compiled alone."""
 
     def __init__(self, lib: Library, progress: Callable[[str, int, int], None] | None = None,
                  cache: Path | None = None):
         self.lib = lib
         self.progress = progress
         self.cache = cache or cache_dir()
-        self.shipped = {d["key"]: d for d in _read_shipped()}
-        self._mem: dict[str, CellTable] = {}
+        self.shipped = _read_shipped()
+        self._mem: dict[tuple, CellTable | None] = {}
         self.measured: list[str] = []
         self.found = {"shipped": 0, "cached": 0, "measured": 0}
 
-    def key_of(self, design, cid: str) -> str:
-        c = design.netlist.cells[cid]
-        return table_key(self.lib[c.cell], c.type, len(c.inputs), dict(c.params),
-                         design.mechanism.ctx.stroke,
-                         _unprefixed(design.mechanism.cells[cid].to_json(), cid))
-
-    def get(self, design, cid: str, moves: Callable[[], list[Move]]) -> CellTable | None:
-        """The table of cell ``cid``; None for a cell not timed alone (stateful, constant)
-        or one that no move switches. ``moves`` gives the changes to measure it on."""
-        c = design.netlist.cells[cid]
-        cls = self.lib[c.cell]
-        if cls.stateful or c.type in UNTIMED:
+    def get(self, cell: str, type_name: str, n: int, params: dict,
+            stroke: float) -> CellTable | None:
+        """The table of ``cell`` as a ``type_name`` of fan-in ``n``; None for a cell that is
+        not timed alone (stateful, constant)."""
+        cls = self.lib[cell]
+        if cls.stateful or type_name in UNTIMED:
             return None
-        key = self.key_of(design, cid)
-        if key in self._mem:
-            return self._mem[key]
-        if key in self.shipped:
-            tab = CellTable.from_json(self.shipped[key])
-            self._mem[key] = tab
-            self.found["shipped"] += 1
-            return tab
-        path = self.cache / f"{c.cell}-{key}.json"
+        mk = (cell, type_name, n, json.dumps(params, sort_keys=True, default=str), stroke)
+        if mk in self._mem:
+            return self._mem[mk]
+        for d in self.shipped:
+            if (d["cell"] == cell and d["type"] == type_name and d["n"] == n
+                    and d["params"] == params and d["stroke"] == stroke
+                    and d.get("source_sha256") == cls.source_sha256):
+                tab = CellTable.from_json(d)
+                self._mem[mk] = tab
+                self.found["shipped"] += 1
+                return tab
+        name = hashlib.sha256(json.dumps([mk, cls.source_sha256, VERSION],
+                                         default=str).encode()).hexdigest()[:24]
+        path = self.cache / f"{cell}-{name}.json"
         if path.exists():
             try:
                 tab = CellTable.from_json(json.loads(path.read_text()))
-                self._mem[key] = tab
+                self._mem[mk] = tab
                 self.found["cached"] += 1
                 return tab
             except (OSError, ValueError, KeyError):
                 pass  # a damaged cache entry is measured again
-        mv = moves()
-        if not mv:
-            return None
         say = self.progress
-        tab = measure_in(design, self.lib, cid, mv,
-                         None if say is None else (lambda d, t: say(cid, d, t)))
-        self.measured.append(cid)
+        tab = measure(cls, self.lib, type_name, n, params, stroke,
+                      None if say is None else (lambda d, t: say(cell, d, t)))
+        self.measured.append(cell)
         self.found["measured"] += 1
         try:
             self.cache.mkdir(parents=True, exist_ok=True)
             path.write_text(json.dumps(tab.to_json()))
         except OSError:
             pass  # an unwritable cache costs a measurement next time, nothing else
-        self._mem[key] = tab
+        self._mem[mk] = tab
         return tab
 
 

@@ -27,7 +27,7 @@ import time
 import networkx as nx
 import numpy as np
 
-from mechc.cells.characterise import SETTLED, CellTable, Move, Tables, crossing, settled_at
+from mechc.cells.characterise import SETTLED, CellTable, Tables, crossing, settled_at
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.ir.netlist import Netlist
@@ -59,9 +59,25 @@ def sample_times(move_time: float, k: int = SAMPLES) -> np.ndarray:
     return move_time * np.interp(np.linspace(0.0, 1.0, k), min_jerk(tau), tau)
 
 
+def cell_tables(design: Design, lib: Library, progress: OnProgress | None
+                ) -> tuple[dict[str, CellTable | None], Tables]:
+    """Each cell's table: shipped, cached, or measured now (``progress`` told the grid
+    points of a cell being measured)."""
+    stroke = design.mechanism.ctx.stroke
+
+    def tick(_cell: str, done: int, total: int) -> None:
+        if progress is not None:
+            progress(done, total)
+
+    tabs = Tables(lib, tick)
+    out = {c.id: tabs.get(c.cell, c.type, len(c.inputs), dict(c.params), stroke)
+           for c in design.netlist.topo_cells()}
+    return out, tabs
+
+
 def net_loads(design: Design) -> dict[str, float]:
     """Mass (kg) each net's driver moves besides its own output: the net's rods and its
-    loads' input sliders."""
+    loads' input sliders (the load axis of the cells' tables)."""
     mech = design.mechanism
     index = mech.body_index()
     out: dict[str, float] = {}
@@ -73,60 +89,6 @@ def net_loads(design: Design) -> dict[str, float]:
             if r.load in index:
                 m += index[r.load].mass
         out[net] = m
-    return out
-
-
-def cell_tables(design: Design, lib: Library, names: list[str],
-                changes: list[tuple[int, int]], progress: OnProgress | None
-                ) -> tuple[dict[str, CellTable | None], Tables]:
-    """Each cell's table, shipped or cached by its geometry's hash, else measured now in the
-    design (a scene of the cell alone) on the first change that switches it on and the first
-    that switches it off (``progress`` told the grid points measured)."""
-    nl = design.netlist
-    n = len(names)
-    cells = nl.topo_cells()
-    per = None
-
-    def moves_of(cid: str) -> list[Move]:
-        nonlocal per
-        if per is None:
-            per = _switches(nl, names, changes)
-        out = []
-        for cur, vec in per.get(cid, []):
-            k = n - (cur ^ vec).bit_length()
-            out.append(Move({nm: float((cur >> (n - 1 - q)) & 1) for q, nm in enumerate(names)},
-                            names[k], float((vec >> (n - 1 - k)) & 1)))
-        return out
-
-    def tick(_cid: str, done: int, total: int) -> None:
-        if progress is not None:
-            progress(done, total)
-
-    tabs = Tables(lib, tick)
-    out = {c.id: tabs.get(design, c.id, lambda cid=c.id: moves_of(cid)) for c in cells}
-    return out, tabs
-
-
-def _switches(nl: Netlist, names: list[str], changes: list[tuple[int, int]]
-              ) -> dict[str, list[tuple[int, int]]]:
-    """Per cell: the first change of ``changes`` that switches its output on and the first
-    that switches it off."""
-    n = len(names)
-    if not changes or nl.state_nets():
-        return {}
-    logic = nl.evaluate({nm: np.array([[(v >> (n - 1 - k)) & 1 for v in pair]
-                                       for pair in changes], dtype=bool).ravel()
-                         for k, nm in enumerate(names)})
-    out: dict[str, list[tuple[int, int]]] = {}
-    for c in nl.cells.values():
-        v = logic.get(c.outputs[0])
-        if v is None:
-            continue
-        v = np.asarray(v).reshape(-1, 2)
-        for want in (True, False):
-            hit = np.flatnonzero((v[:, 0] != v[:, 1]) & (v[:, 1] == want))
-            if len(hit):
-                out.setdefault(c.id, []).append(changes[int(hit[0])])
     return out
 
 
@@ -149,7 +111,7 @@ def prove_timing(design: Design, spec: Spec, lib: Library,
     n = len(names)
     vectors = plan(n, settings.cases, settings.seed)
     changes = list(zip([0, *vectors], vectors))
-    tables, tabs = cell_tables(design, lib, names, changes, progress)
+    tables, tabs = cell_tables(design, lib, progress)
     timed = predict_changes(design, lib, names, changes, st, tables)
     budget = st.move_time + st.settle_time
     failures: list[dict] = []
@@ -212,8 +174,8 @@ def predict_changes(design: Design, lib: Library, names: list[str],
     types = {c.id: c.cell for c in nl.cells.values()}
     n = len(names)
     ts = sample_times(st.move_time)
-    loads = net_loads(design)
     driver = {c.outputs[0]: c for c in nl.cells.values()}
+    loads = net_loads(design)
     figs = {cid: (tab.at(st.move_time, loads.get(nl.cells[cid].outputs[0], 0.0))
                   if tab is not None else None) for cid, tab in tables.items()}
     out: list[dict] = []
@@ -299,7 +261,7 @@ def seq_timing_engine(design: Design, spec: SeqSpec, lib: Library, settings: Pro
     cells' characterised delays (a gate's lag at its load; an AMPLIFIER's or any cell without
     a table, its stated ``switching_delay_s``)."""
     t0 = time.perf_counter()
-    tables, _tabs = cell_tables(design, lib, [], [], progress)
+    tables, _tabs = cell_tables(design, lib, progress)
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
                       move_time=settings.move_time)
     nl = design.netlist
@@ -308,8 +270,9 @@ def seq_timing_engine(design: Design, spec: SeqSpec, lib: Library, settings: Pro
     for c in nl.cells.values():
         tab = tables.get(c.id)
         stated = float(getattr(lib[c.cell], "switching_delay_s", 0.0))
-        delay[c.id] = (max(stated, tab.at(st.move_time, loads.get(c.outputs[0], 0.0))["lag_s"])
-                       if tab is not None else stated)
+        lag = (tab.at(st.move_time, loads.get(c.outputs[0], 0.0))["lag_s"] if tab is not None
+               else 0.0)
+        delay[c.id] = max(stated, lag)
     reqs = ((design.stats.get("sequential") or {}).get("ordering") or {}).get("requirements",
                                                                             [])
     found = []
