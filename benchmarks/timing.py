@@ -115,7 +115,7 @@ def main() -> None:
             vectors = vectors[:cases]
         changes = list(zip([0, *vectors], vectors))
         t0 = time.perf_counter()
-        tables, tabs = cell_tables(design, LIB, None)
+        tables, tabs = cell_tables(design, LIB, None, names, changes)
         t_char = time.perf_counter() - t0
         t0 = time.perf_counter()
         pred = predict_changes(design, LIB, names, changes, st, tables)

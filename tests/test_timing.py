@@ -193,3 +193,37 @@ def test_cli_timing_level(cli):
     code, _out, err = cli("simulate", str(EXAMPLES / "sorter.bool"), "--level", "timing",
                           "--trace", "/tmp/never.json")
     assert code == 2 and "timing level has none" in err
+
+
+@pytest.mark.slow
+def test_amplifier_is_timed_as_built_and_predicts_its_landing(tmp_path, monkeypatch):
+    """An AMPLIFIER's switching delay and landing depend on what compile sized it for: it is
+    timed as the design built it (a table per geometry, cached), and the settle time it
+    predicts for the output behind it is within 15 % of the whole scene's."""
+    monkeypatch.setenv("MECHC_CACHE_DIR", str(tmp_path))
+    amp = LIB["amplifier"]
+    nl = Netlist(["a", "b"])
+    nl.add_cell(CellInst("g1", "amplifier", "AMPLIFIER", ("a",), ("n1",), {"reason": "force"}),
+                pin_names=amp.input_names(1))
+    nl.add_cell(CellInst("g2", "and", "AND", ("n1", "b"), ("z",)),
+                pin_names=LIB["and"].input_names(2))
+    nl.set_output("z", "z")
+    d = compile_netlist(load_spec_text("inputs a b\noutputs z\nz = a & b\n"), nl, library=LIB)
+    names = ["a", "b"]
+    changes = [(0b01, 0b11), (0b11, 0b01)]  # b on: a switches z on, then off
+    st = dyn_settings(d)
+    tables, tabs = cell_tables(d, LIB, None, names, changes)
+    assert tabs.measured == ["g1"]  # the amplifier as built; the AND from the shipped table
+    assert tables["g1"].values["lag_s"][1][0] > 0.02  # a delay of its own, not quasi-static
+    pred = predict_changes(d, LIB, names, changes, st, tables)
+    types = {c.id: c.cell for c in nl.cells.values()}
+    for (cur, vec), p in zip(changes, pred):
+        sc = Scene.build(d.mechanism, LIB, types, st, {"a": float(cur >> 1), "b": 1.0})
+        r = sc.move("a", float(vec >> 1))
+        t = np.concatenate([[0.0], r.t])
+        s = np.concatenate([[r.outputs["z"][0]], r.outputs["z"]])
+        assert p["outputs"]["z"]["path"] == ["g1", "g2"]
+        assert p["outputs"]["z"]["settle_s"] == pytest.approx(ch.settled_at(t, s), rel=0.15)
+        assert p["outputs"]["z"]["switch_s"] == pytest.approx(ch.crossing(t, s), rel=0.15)
+    _again, tabs2 = cell_tables(d, LIB, None, names, changes)
+    assert tabs2.found["cached"] == 1 and not tabs2.measured

@@ -74,6 +74,7 @@ class CellTable:
     changes: int  # switching changes measured per grid point
     seconds: float = 0.0
     sha: str = ""  # the cell file's SHA-256 when it was measured
+    as_built: bool = False  # measured on the cell as a design built it (not compiled alone)
 
     def at(self, move_time: float, load: float) -> dict[str, float]:
         """Every figure at ``move_time`` and ``load``, bilinear between grid points and held
@@ -98,7 +99,8 @@ class CellTable:
                 "params": self.params, "stroke": self.stroke,
                 "move_times_s": list(self.move_times), "loads_kg": list(self.loads),
                 "values": self.values, "changes": self.changes,
-                "seconds": round(self.seconds, 3), "source_sha256": self.sha}
+                "seconds": round(self.seconds, 3), "source_sha256": self.sha,
+                "as_built": self.as_built}
 
     @staticmethod
     def from_json(d: dict) -> CellTable:
@@ -106,7 +108,7 @@ class CellTable:
                          float(d["stroke"]), tuple(d["move_times_s"]), tuple(d["loads_kg"]),
                          {k: [list(map(float, r)) for r in v] for k, v in d["values"].items()},
                          int(d["changes"]), float(d.get("seconds", 0.0)),
-                         d.get("source_sha256", ""))
+                         d.get("source_sha256", ""), bool(d.get("as_built", False)))
 
 
 def cache_dir() -> Path:
@@ -354,6 +356,50 @@ class Tables:
             pass  # an unwritable cache costs a measurement next time, nothing else
         self._mem[mk] = tab
         return tab
+
+    def instance(self, design, cid: str, moves: Callable[[], list[Move]]) -> CellTable | None:
+        """The table of cell ``cid`` as ``design`` built it (its own springs, dashpot and
+        masses; keyed by that geometry's hash, cached), measured on a scene of that cell in
+        the design on ``moves``; None when no move switches it."""
+        c = design.netlist.cells[cid]
+        key = table_key(self.lib[c.cell], c.type, len(c.inputs), dict(c.params),
+                        design.mechanism.ctx.stroke,
+                        _unprefixed(design.mechanism.cells[cid].to_json(), cid))
+        if key in self._mem:
+            return self._mem[key]
+        path = self.cache / f"{c.cell}-{key}.json"
+        if path.exists():
+            try:
+                tab = CellTable.from_json(json.loads(path.read_text()))
+                self._mem[key] = tab
+                self.found["cached"] += 1
+                return tab
+            except (OSError, ValueError, KeyError):
+                pass  # a damaged cache entry is measured again
+        mv = moves()
+        if not mv:
+            return None
+        say = self.progress
+        tab = measure_in(design, self.lib, cid, mv,
+                         None if say is None else (lambda d, t: say(cid, d, t)))
+        tab.as_built = True
+        self.measured.append(cid)
+        self.found["measured"] += 1
+        try:
+            self.cache.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(tab.to_json()))
+        except OSError:
+            pass  # an unwritable cache costs a measurement next time, nothing else
+        self._mem[key] = tab
+        return tab
+
+
+def per_instance(cls: type[Cell]) -> bool:
+    """Whether a cell is timed as each design builds it rather than from the table of the
+    cell compiled alone: a cell with a switching delay of its own (a powered AMPLIFIER),
+    whose landing depends on the springs and dashpot compile sizes for its loads. A linkage
+    gate is quasi-static: its alone table serves every instance."""
+    return float(getattr(cls, "switching_delay_s", 0.0) or 0.0) > 0.0
 
 
 def _read_shipped() -> list[dict]:
