@@ -15,10 +15,14 @@ load its net drives). Per grid point, the worst change gives:
 - ``force_N``: the peak inertial force on the output body (its mass with the load times its
   peak acceleration), what the cell must deliver to switch its load at that speed.
 
-Tables are looked up by a key hashing the cell's file, its type, fan-in, parameters, stroke
-and the geometry it compiles to: the stdlib's ship with mechc (``characterised.json``,
-written by ``mechc cells characterise``), a user cell's are measured on first use and cached
-in ``$MECHC_CACHE_DIR`` (default ``$XDG_CACHE_HOME/mechc`` or ``~/.cache/mechc``).
+A linkage gate is quasi-static, so the table of the cell compiled alone serves every instance:
+the stdlib's ship with mechc (``characterised.json``, written by ``mechc cells characterise``,
+each with the SHA-256 of the cell file measured), any other is measured on first use and
+cached in ``$MECHC_CACHE_DIR`` (default ``$XDG_CACHE_HOME/mechc/cells`` or
+``~/.cache/mechc/cells``). A cell with a switching delay of its own (a powered AMPLIFIER) lands
+as the springs and dashpot compile sized for its loads make it: it is measured as the design
+built it, on a scene of that cell in the design, and cached under the hash of that geometry
+less its placement (:func:`table_key`).
 """
 
 from __future__ import annotations

@@ -7,8 +7,9 @@ proof's own plan) the whole mechanism's closed form is evaluated along the move,
 sample's time is where the minimum-jerk profile puts that input position. On top, each cell
 on the switching path adds what its table says the dynamics add at its input speed and the
 mass its output net drives: the lag of its mid-stroke crossing, and (the last cell) how much
-later it settles. Path delays are the longest sum through the cells whose output switches
-(static timing analysis over the netlist's DAG).
+later it settles; an AMPLIFIER, timed as the design built it, passes its late landing on.
+Path delays are the longest sum through the cells whose output switches (static timing
+analysis over the netlist's DAG).
 
 Per change and switching output: ``switch_s`` (the output crosses mid-stroke) and
 ``settle_s`` (it stays within 0.5 % of stroke of its end), both from the start of the input's
