@@ -221,3 +221,139 @@ def test_sequential_samples_agree_with_their_walks_proven_one_by_one(tmp_path):
     assert "spring force margin" not in result.fails
     assert (np.array(alone) == result.sample_pass).all()
     assert 0 < result.passed < len(X)  # some of each
+
+
+# ---- dimensions of the cells' own kinematics: cam pairs, a MEMORY's throw, toggle stops -----
+
+@pytest.fixture(scope="module")
+def threshold_fa(tmp_path_factory):
+    return _compile("full_adder.bool", tmp_path_factory.mktemp("tol") / "fa_thr.json",
+                    "--map", "threshold")
+
+
+def _rest_poses(design, lib, mech):
+    from mechc.physics.evaluate import evaluate
+    from mechc.proofs.cases import bits
+
+    names = list(design.spec.inputs)
+    x = bits(np.arange(1 << len(names), dtype=np.int64), len(names)).astype(float)
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    return evaluate(mech, lib, types, {n: x[k] for k, n in enumerate(names)})
+
+
+def _angle_at(zk, arm, r):
+    """The angle at Z between ZK and ZH with |KH| = r (law of cosines)."""
+    return np.arccos((zk ** 2 + arm ** 2 - r ** 2) / (2 * zk * arm))
+
+
+def test_cam_profile_error_is_sampled_and_agrees_with_the_exact_dwell(threshold_fa):
+    """The threshold generators' cam outlines (radial error per program segment) and rollers
+    are dimensions of the sample set; a uniform radial error e turns the follower, on a dwell
+    (the pitch curve a circle about K there), by what the exact meeting of the circles about K
+    (radius rho + 2e: cam and roller each e larger) and Z gives, to first order."""
+    design, lib = _load(threshold_fa)
+    dims = dimensions(design.mechanism)
+    cam = [k for k, d in enumerate(dims) if d.what in ("cam profile", "roller radius")]
+    assert {dims[k].owner for k in cam} == {"t1", "t2"} and len(cam) >= 6
+    X = draw(dims, ToleranceSettings(samples=4))
+    assert (X[:, cam] != 0).all()
+    e = 0.05
+    delta = np.zeros(len(dims))
+    delta[cam] = e
+    nominal = _rest_poses(design, lib, design.mechanism)
+    moved = _rest_poses(design, lib, perturb(design.mechanism, dims, list(delta)))
+    for cid in ("t1", "t2"):
+        part = design.mechanism.cells[cid]
+        info = part.data["threshold"]
+        fol = next(b for b in part.bodies if b.id == info["follower_body"])
+        cam_b = next(b for b in part.bodies if b.id == info["cam_body"])
+        touch = next(j for j in part.joints if j.id == info["touch_joint"])
+        Z, K, H = (np.asarray(v) for v in (fol.pivot, cam_b.pivot, touch.q))
+        th0 = nominal.theta[fol.id]
+        th1 = moved.theta[fol.id]
+        c, s = np.cos(th0), np.sin(th0)
+        hx = Z[0] + c * (H[0] - Z[0]) - s * (H[1] - Z[1])  # the roller's centre at rest
+        hy = Z[1] + s * (H[0] - Z[0]) + c * (H[1] - Z[1])
+        kt = nominal.theta[cam_b.id]  # K -> roller in the cam's frame: the dwell's radius
+        rho = np.hypot(hx - K[0], hy - K[1])
+        arm, zk = np.hypot(*(H - Z)), np.hypot(*(K - Z))
+
+        exact = np.abs(_angle_at(zk, arm, rho + 2 * e) - _angle_at(zk, arm, rho))
+        assert np.isfinite(kt).all()
+        got = np.abs(th1 - th0)
+        assert (exact > 1e-3).all()
+        np.testing.assert_allclose(got, exact, rtol=0.05)
+
+
+def test_a_large_cam_error_fails_the_threshold_adder_and_a_tiny_one_does_not(threshold_fa):
+    design, lib = _load(threshold_fa)
+    dims = dimensions(design.mechanism)
+    verdict = {}
+    for e in (0.005, 0.3):
+        delta = [e if d.what == "cam profile" else 0.0 for d in dims]
+        one = replace(design, mechanism=perturb(design.mechanism, dims, delta))
+        verdict[e] = prove_kinematic(one, one.spec, lib).passed
+    assert verdict == {0.005: True, 0.3: False}
+    r = run(design, lib, ToleranceSettings(tol=0.1, clearance=0.0, spring_tol=0.0,
+                                           samples=8))
+    effect = {x.dim.name: x.position_mm for x in r.ranked}
+    # a cam pair's radial error reaches the output through the follower's short arm:
+    # amplified (over 3 x), far above a separator link's end
+    assert effect["t2.cam.r1"] > 3 * 0.1
+
+
+@pytest.fixture(scope="module")
+def speedctl(tmp_path_factory):
+    return _compile("speedctl.fsm", tmp_path_factory.mktemp("tol") / "speedctl.json")
+
+
+def _cell_output(lib, types, part, cid, fixed, out, state=None):
+    poses = lib[types[cid]].kinematics(part, fixed, 1, state)
+    return float(np.asarray(poses.u[part.terminals[out].body]).reshape(-1)[0])
+
+
+@pytest.mark.parametrize("cell", ["memory", "amplifier"])
+def test_a_stop_cut_off_moves_the_throw_it_sets(speedctl, cell):
+    """A MEMORY's throw angle and an AMPLIFIER's toggle angles are set by stops on the frame:
+    those stops are dimensions of the sample set, and a stop cut 0.3 mm off moves the output at
+    rest by what the lever's arms give (MEMORY: the face's 0.3 mm at radius a becomes rq/a of
+    it at the output pin; AMPLIFIER: the stop catches the crank pin itself, 1:1)."""
+    design, lib = _load(speedctl)
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    cid = next(c for c, t in types.items() if t == cell)
+    part = design.mechanism.cells[cid]
+    dims = dimensions(design.mechanism)
+    lever = next(b for b in part.bodies if b.kind == "lever"
+                 and any(j.kind == "contact" and j.a == "ground" and j.b == b.id
+                         for j in part.joints))
+    stop_i, stop = next((i, j) for i, j in enumerate(part.joints)
+                        if j.kind == "contact" and j.a == "ground" and j.b == lever.id
+                        and j.normal[0] < 0)  # the stop of the "on" side
+    name = f"{stop.id}.pa.x"
+    assert name in [d.name for d in dims]
+    S = design.mechanism.ctx.stroke
+    ins, out = (("S", "R"), "Q") if cell == "memory" else (("A",), "Z")
+    # MEMORY: S and R off, the lever on (held by its detent); AMPLIFIER: input on
+    fixed = {part.terminals[n].body: np.array([S / 2 if cell == "amplifier" else -S / 2])
+             for n in ins}
+    state = None if cell == "amplifier" else np.array([1.0])  # on, held by the detent
+    h = 0.3
+    moved = perturb_one(part, stop_i, h)
+    du = _cell_output(lib, types, moved, cid, fixed, out, state) - _cell_output(
+        lib, types, part, cid, fixed, out, state)
+    if cell == "memory":
+        a = stop.pb[1] - lever.pivot[1]
+        rod = next(j for j in part.joints if j.kind == "rod")
+        rq = rod.pa[1] - lever.pivot[1]
+        want = h * rq / a
+    else:
+        want = h
+    assert du == pytest.approx(want, rel=0.05), (du, want)
+
+
+def perturb_one(part, i, h):
+    """The part with joint ``i``'s ``pa`` moved by ``h`` along x."""
+    joints = list(part.joints)
+    j = joints[i]
+    joints[i] = replace(j, pa=(j.pa[0] + h, j.pa[1]))
+    return replace(part, joints=joints)

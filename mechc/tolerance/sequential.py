@@ -45,7 +45,7 @@ class SequentialBatch:
         # joint points, cell rods' lengths and pivots (a net rod's own length needs the
         # combinational batch's rods: here a net's rod follows its pins, as in a design file)
         self.geo = [k for k, d in enumerate(dims)
-                    if d.obj == "joint" or (d.obj == "body" and d.attr == "pivot")]
+                    if d.obj in ("joint", "data") or (d.obj == "body" and d.attr == "pivot")]
         self.spring_dims = {(d.part, d.index, d.attr): k for k, d in enumerate(dims)
                             if d.obj == "spring"}
         self.lost: dict[str, np.ndarray] = {}
