@@ -92,9 +92,12 @@ class ThresholdCell(Cell):
         return n_inputs * 2 + (2 if n_inputs == 2 else 4) + 5
 
     @classmethod
-    def design(cls, n_inputs: int, params: dict, stroke: float) -> GeneratorDesign:
+    def design(cls, n_inputs: int, params: dict, stroke: float,
+               angle_margin: float = 0.0) -> GeneratorDesign:
+        """``angle_margin``: degrees of separator transmission angle beyond the limit (robust
+        design asks for it: the angle scatters with the tolerances)."""
         tt = truth_table(params, n_inputs)
-        d = design_generator(tt, stroke_mm=stroke, mu_min_deg=MU_MIN_DEG,
+        d = design_generator(tt, stroke_mm=stroke, mu_min_deg=MU_MIN_DEG + angle_margin,
                              pressure_limit_deg=PRESSURE_LIMIT_DEG)
         if d.kind != "generator":
             raise DesignError(f"THRESHOLD {params}: the function is a {d.kind}; map it to a "
@@ -103,7 +106,7 @@ class ThresholdCell(Cell):
 
     @classmethod
     def synthesise(cls, cid, ctx, n_inputs, params, demand):
-        d = cls.design(n_inputs, params, ctx.stroke)
+        d = cls.design(n_inputs, params, ctx.stroke, ctx.angle_margin)
         return build_part(cid, ctx, n_inputs, d, demand, cls.input_names(n_inputs))
 
     @classmethod

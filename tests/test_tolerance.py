@@ -357,3 +357,69 @@ def perturb_one(part, i, h):
     j = joints[i]
     joints[i] = replace(j, pa=(j.pa[0] + h, j.pa[1]))
     return replace(part, joints=joints)
+
+
+@pytest.mark.slow
+def test_sequential_pin_play_covers_rods_at_their_play(tmp_path):
+    """Sequential designs get pin play and structural error as combinational ones do: the
+    lost motion from the finite differences along the walks covers the toggle made with every
+    rod of its cells c longer and c shorter, each proven exactly by the sequential kinematic
+    proof."""
+    from mechc.proofs import ProofSettings, prove
+
+    path = _compile("toggle.fsm", tmp_path / "toggle.json")
+    design, lib = _load(path)
+    c = 0.2
+    r = run(design, lib, ToleranceSettings(tol=0.0, clearance=c, spring_tol=0.0, samples=1))
+    assert r.structural and all(e.lost_mm > 0 for e in r.structural)
+    dims = dimensions(design.mechanism)
+    worst = 1.0
+    for sign in (-1.0, 1.0):
+        delta = [sign * c if d.what == "rod length" else 0.0 for d in dims]
+        one = replace(design, mechanism=perturb(design.mechanism, dims, delta))
+        rep = prove(one, one.spec, lib, "kinematic", ProofSettings(tolerance=0.05))
+        worst = min(worst, 0.05 - rep.figures["max_deviation_fraction"])
+    stroke = design.mechanism.ctx.stroke
+    assert min(r.nominal_margin_mm.values()) <= worst * stroke + 1e-5
+    # and the play costs margin: without it the nominal margin is larger
+    r0 = run(design, lib, ToleranceSettings(tol=0.0, clearance=0.0, spring_tol=0.0, samples=1))
+    assert min(r0.nominal_margin_mm.values()) > min(r.nominal_margin_mm.values()) + 0.01
+
+
+def test_interference_bound_holds_on_perturbed_designs(sorter):
+    """The interference bound: for every pair held to a gap at nominal and every sample, the
+    gap the interference check measures on that sample's design (its own poses in every
+    proof state, its outlines cut larger or smaller) is at least the bound; and a large
+    tolerance puts the pairs closest at nominal at risk."""
+    from mechc.physics.evaluate import evaluate
+    from mechc.physics.interference import Interference
+    from mechc.tolerance.clearance import Risk
+    from mechc.tolerance.montecarlo import nominal_gaps, prepare
+
+    design, lib = _load(sorter)
+    s = ToleranceSettings(tol=0.4, clearance=0.0, spring_tol=0.0, samples=24, seed=5)
+    batch, _ = prepare(design, lib, s)
+    X = draw(batch.dims, s)
+    X[:, [k for k, d in enumerate(batch.dims) if d.part.startswith("net:")]] = 0.0
+    res = batch.run(X)
+    risk = Risk(design.mechanism)
+    risk.add(res.moves, len(X))
+    bounds = risk.bounds(nominal_gaps(batch, risk, s), s.tol, s.clearance, len(X))
+    # some samples at risk (a finite bound below zero; a sample that cannot assemble in some
+    # state has infinite moves: -inf, at risk, and fails its proof anyway)
+    assert bounds and any((np.isfinite(b) & (b < 0)).any() for _, _, b in bounds.values())
+    st = batch.states
+    values = {n: st.values[k] for k, n in enumerate(st.names)}
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    checked = 0
+    for i in range(len(X)):
+        mech = perturb(design.mechanism, batch.dims, list(X[i]))
+        poses = evaluate(mech, lib, types, values)
+        inter = Interference(mech, clearance=10.0)
+        inter.add(poses)
+        got = inter.results
+        for pair, (_, _, b) in bounds.items():
+            if pair in got and np.isfinite(b[i]):
+                assert got[pair].gap >= b[i] - 1e-6, (pair, got[pair].gap, b[i])
+                checked += 1
+    assert checked >= 3
