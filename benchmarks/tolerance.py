@@ -80,7 +80,8 @@ def speed(samples: int, chart: str | None) -> None:
         print(f"  chart: {chart}")
 
 
-def markdown(samples: int, tol: float, clearance: float, spring_tol: float) -> None:
+def markdown(samples: int, tol: float, clearance: float, spring_tol: float,
+             only: list[str] | None = None) -> None:
     s = ToleranceSettings(tol=tol, clearance=clearance, spring_tol=spring_tol, samples=samples)
     print(f"| design | dimensions | yield ({samples} samples) | 95 % interval | most frequent "
           "failing check | dimension that matters most | output scatter at rest (99 %) | "
@@ -88,6 +89,8 @@ def markdown(samples: int, tol: float, clearance: float, spring_tol: float) -> N
     print("|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for spec, extra in EXAMPLES:
+            if only and spec not in only:
+                continue
             d, lib = compiled(spec, extra, Path(tmp) / "d.json")
             r = run(d, lib, s)
             lo, hi = r.ci
@@ -182,6 +185,8 @@ def main() -> None:
     p.add_argument("--samples", type=int, default=None)
     p.add_argument("--chart", default="tolerance_sorter.png")
     p.add_argument("--markdown", action="store_true")
+    p.add_argument("--only", nargs="+", metavar="SPEC",
+                   help="with --markdown: only these examples (file names)")
     p.add_argument("--scale", action="store_true")
     p.add_argument("--tol", type=float, default=0.1)
     p.add_argument("--clearance", type=float, default=0.05)
@@ -191,7 +196,7 @@ def main() -> None:
         scale(a.samples or 500, a.chart if a.chart != "tolerance_sorter.png"
               else "tolerance_scale.png")
     elif a.markdown:
-        markdown(a.samples or 2000, a.tol, a.clearance, a.spring_tol)
+        markdown(a.samples or 2000, a.tol, a.clearance, a.spring_tol, a.only)
     else:
         speed(a.samples or 10_000, a.chart)
 

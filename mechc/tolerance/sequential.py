@@ -109,7 +109,7 @@ class SequentialBatch:
         moves: dict[str, np.ndarray] = {}
         step = 0
 
-        def moved(poses: Poses, n: int) -> None:
+        def record(poses: Poses, n: int) -> None:
             nonlocal step
             if keep is not None:
                 keep.append(poses)
@@ -130,7 +130,7 @@ class SequentialBatch:
             poses, state, _ = settle(at_rest, self.lib, self.types,
                                      {k: np.full(M, v) for k, v in cur.items()})
             self._read(at_rest, poses, M, 1, paths)
-            moved(poses, 1)
+            record(poses, 1)
             for k in range(1, len(seq)):
                 moved = next(n for n in seq[k] if seq[k][n] != cur[n])
                 vals = {n: np.full(M * ns, v) for n, v in cur.items()}
@@ -145,7 +145,7 @@ class SequentialBatch:
                             jam += np.broadcast_to(bad, (M * ns,)).reshape(M, ns).any(axis=1)
                 osc += np.broadcast_to(changing, (M * ns,)).reshape(M, ns).any(axis=1)
                 self._read(at_step, poses, M, ns, paths)
-                moved(poses, ns)
+                record(poses, ns)
                 self._springs(at_step, poses, delta, M, ns, springs)
                 state = {c: np.asarray(v).reshape(M, ns)[:, -1] for c, v in path_state.items()}
                 cur = {n: float(v) for n, v in seq[k].items()}
