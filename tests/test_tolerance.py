@@ -423,3 +423,17 @@ def test_interference_bound_holds_on_perturbed_designs(sorter):
                 assert got[pair].gap >= b[i] - 1e-6, (pair, got[pair].gap, b[i])
                 checked += 1
     assert checked >= 3
+
+
+def test_sequential_run_has_play_structural_error_and_ranking(tmp_path):
+    """A sequential design's run (the gated latch): pin play at its outputs, a structural
+    error per output, and dimensions ranked by their finite differences (the MEMORY's and
+    the gates' stops move its output at rest 1:1)."""
+    path = _compile("gated_latch.fsm", tmp_path / "latch.json")
+    design, lib = _load(path)
+    r = run(design, lib, ToleranceSettings(tol=0.1, clearance=0.05, spring_tol=0.1,
+                                           samples=16))
+    assert r.samples == 16 and r.structural
+    assert all(e.lost_mm > 0 and e.spread_mm[0] <= 0 <= e.spread_mm[1] for e in r.structural)
+    assert r.ranked[0].position_mm >= 0.09
+    assert r.ranked[-1].position_mm == 0.0
