@@ -16,6 +16,12 @@ any point of a body moves in any state is at most
 - plus half the pin clearance of its own pins (the play of the chain before it is in its pose
   only through its pins' positions, not their play: not covered).
 
+A sequential design's bodies are compared at the end of every step of its walks (at rest):
+mid-step a sample's MEMORY may throw a little earlier or later than the nominal one, which
+moves its parts by a stroke at the same point of the walk, a difference of timing the bound
+cannot use. So for a sequential design the bound covers the walks' rest states only (the
+nominal gaps are still the closest over every point of the walks).
+
 A pair may touch in a sample when g minus both bodies' moves is below zero. It is a bound,
 not a proof: the largest moves need not happen in the state of the closest gap, nor towards
 the other part, so it over-counts; it is reported beside the yield, not counted in it.
@@ -55,9 +61,10 @@ def radius(body: Body) -> float:
 
 
 def displacement(bodies: list[Body], poses: Poses, nominal: Poses, M: int, n: int,
-                 radii: dict[str, float]) -> dict[str, np.ndarray]:
+                 radii: dict[str, float], last: bool = False) -> dict[str, np.ndarray]:
     """Per body, per sample: the most any of its points moves from its nominal pose over the
-    ``n`` states (``poses``: M x n, ``nominal``: n); unsolvable: infinite."""
+    ``n`` states (``poses``: M x n, ``nominal``: n; ``last``: the last state only);
+    unsolvable: infinite."""
     out = {}
 
     def diff(now, was) -> np.ndarray:
@@ -75,7 +82,7 @@ def displacement(bodies: list[Body], poses: Poses, nominal: Poses, M: int, n: in
                                  diff(poses.xy[b.id][1], nominal.xy[b.id][1]))
         else:
             continue
-        out[b.id] = d.max(axis=1)
+        out[b.id] = d[:, -1] if last else d.max(axis=1)
     return out
 
 

@@ -114,8 +114,9 @@ class SequentialBatch:
             if keep is not None:
                 keep.append(poses)
             elif self._nominal:
+                # at the step's end only: mid-step a MEMORY's throw is a jump in time
                 for b, d in displacement(self.solid, poses, self._nominal[step], M, n,
-                                         self.radii).items():
+                                         self.radii, last=True).items():
                     moves[b] = np.maximum(moves[b], d) if b in moves else d
             step += 1
 
