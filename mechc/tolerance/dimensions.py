@@ -2,7 +2,9 @@
 
 A dimension is one number of the geometry a maker cuts, drills or buys: a coordinate of a
 joint's point (a pin hole, a slot's end, a contact face, a stop on the frame), a rod's length,
-a lever's pivot, a spring's rate and preload, a part's outline. :func:`perturb` gives the
+a lever's pivot, a spring's rate and preload, a part's outline, a threshold generator's cam
+outline (its radial error per segment of the follower program) and roller radius (data its
+cell's kinematics reads: ``profile_error``). :func:`perturb` gives the
 mechanism with every dimension at a value of its own; a value may be an array (one entry per
 sample and state of a tolerance run), which the closed forms (``mechc.physics.closed_form`` and
 the part kinds) carry through as they carry states, so many perturbed designs are solved in one

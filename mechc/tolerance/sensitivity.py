@@ -84,7 +84,7 @@ def rank(jac: Jacobian, tols: np.ndarray, stroke: float, deltas: np.ndarray | No
     """Dimensions by how far each alone moves an output at its tolerance (largest first); the
     regression of the samples' margin on their deltas alongside, where samples are given."""
     D = len(jac.dims)
-    pos = np.zeros(D)  # no derivatives (a sequential design): zero, ranked by regression
+    pos = np.zeros(D)  # no derivatives (none given): zero, ranked by regression
     for J in jac.d.values():
         pos = np.maximum(pos, np.abs(J).max(axis=1) * tols * stroke)
     coef = np.zeros(D)
