@@ -43,8 +43,9 @@ they must move). Pin clearance is lost motion at every pin, taken up the worst w
 solved together (one evaluation of the closed forms over samples x states).
 
 Prints the yield with its 95 % (Wilson) interval, the checks that fail most, each output's
-structural error (scatter of its rest positions against the stroke) and the dimensions that
-matter most (finite differences of the closed forms; regression of the samples' margin).
+structural error (scatter of its rest positions against the stroke), the pairs of parts the
+interference bound says may touch (not counted in the yield) and the dimensions that matter
+most (finite differences of the closed forms; regression of the samples' margin).
 
 processes (--process; explicit --tol/--clearance/--spring-tol override it):
 {procs}
