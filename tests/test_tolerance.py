@@ -437,3 +437,30 @@ def test_sequential_run_has_play_structural_error_and_ranking(tmp_path):
     assert all(e.lost_mm > 0 and e.spread_mm[0] <= 0 <= e.spread_mm[1] for e in r.structural)
     assert r.ranked[0].position_mm >= 0.09
     assert r.ranked[-1].position_mm == 0.0
+
+
+@pytest.mark.slow
+def test_angle_margin_gives_the_threshold_generators_their_angle():
+    """What robust design asks of the threshold generators (the design rule angle_margin):
+    the separators synthesised for 45 deg + the margin, so the design's transmission angle
+    check reads at least that, and the rule is written with the design."""
+    from mechc.cells.library import load_library
+    from mechc.frontends import load_spec
+    from mechc.passes.assemble import MechOptions
+    from mechc.passes.map_sop import MapOptions
+    from mechc.pipeline import CompileOptions, compile_spec
+
+    spec = load_spec(EXAMPLES / "full_adder.bool")
+    lib = load_library()
+    angle = {}
+    for margin in (0.0, 5.0):
+        d = compile_spec(spec, CompileOptions(map=MapOptions(target="threshold"),
+                                              mech=MechOptions(angle_margin=margin)), lib)
+        gen = {c.id for c in d.netlist.cells.values() if c.cell == "threshold"}
+        assert gen
+        angle[margin] = min(c.value for c in d.mechanism.checks
+                            if c.name == "transmission angle"
+                            and c.where in gen)
+        assert design_to_json(d)["mechanism"]["rules"]["angle_margin"] == margin
+    assert angle[0.0] == pytest.approx(45.01, abs=0.02)
+    assert angle[5.0] >= 50.0
