@@ -464,3 +464,26 @@ def test_angle_margin_gives_the_threshold_generators_their_angle():
         assert design_to_json(d)["mechanism"]["rules"]["angle_margin"] == margin
     assert angle[0.0] == pytest.approx(45.01, abs=0.02)
     assert angle[5.0] >= 50.0
+
+
+def test_threshold_samples_agree_with_their_json_proven_one_by_one(threshold_fa, tmp_path):
+    """The cam pairs' errors travel with a design written as JSON (the cell's
+    ``profile_error``): perturbed threshold adders proven one by one by the kinematic proof
+    pass or fail as the run's samples do."""
+    design, lib = _load(threshold_fa)
+    s = ToleranceSettings(tol=0.03, clearance=0.0, spring_tol=0.0, samples=16, seed=4)
+    dims = dimensions(design.mechanism)
+    X = draw(dims, s)
+    X[:, [k for k, d in enumerate(dims) if d.part.startswith("net:")]] = 0.0
+    result = run(design, lib, s, deltas=X)
+    alone = []
+    for i in range(len(X)):
+        one = replace(design, mechanism=perturb(design.mechanism, dims, list(X[i])))
+        path = tmp_path / f"t{i}.json"
+        path.write_text(dumps(design_to_json(one)))
+        back, lib2 = _load(path)
+        assert "profile_error" in back.mechanism.cells["t1"].data["threshold"]
+        alone.append(prove_kinematic(back, back.spec, lib2, tolerance=s.proof_tolerance).passed)
+    alone = np.array(alone)
+    assert (alone == result.sample_pass).all(), np.flatnonzero(alone != result.sample_pass)
+    assert 0 < alone.sum() < len(alone)  # some of each
