@@ -487,3 +487,23 @@ def test_threshold_samples_agree_with_their_json_proven_one_by_one(threshold_fa,
     alone = np.array(alone)
     assert (alone == result.sample_pass).all(), np.flatnonzero(alone != result.sample_pass)
     assert 0 < alone.sum() < len(alone)  # some of each
+
+
+def test_spring_rate_and_preload_are_sampled_and_a_weak_spring_fails(sorter):
+    """Springs: every spring's rate and preload are dimensions; one spring 20 % weak in both
+    fails its force margin (1.3 x 0.8 x 0.8 = 0.83 < 1.15) and nothing else."""
+    design, lib = _load(sorter)
+    dims = dimensions(design.mechanism)
+    springs = [k for k, d in enumerate(dims) if d.what in ("spring rate", "spring preload")]
+    assert len(springs) == 2 * sum(len(p.springs) for p in design.mechanism.all_parts())
+    k_rate = next(k for k in springs if dims[k].what == "spring rate"
+                  and dims[k].owner == "c6")
+    sid = dims[k_rate].name.split(" ")[0]
+    k_pre = next(k for k in springs if dims[k].name == f"{sid} preload")
+    X = np.zeros((2, len(dims)))
+    X[1, [k_rate, k_pre]] = -0.2
+    r = run(design, lib, ToleranceSettings(tol=0.0, clearance=0.0, spring_tol=0.2,
+                                           samples=2), deltas=X)
+    assert list(r.sample_pass) == [True, False]
+    assert [f.key.where for f in r.failing] == [sid]
+    assert r.failing[0].worst == pytest.approx(1.3 * 0.8 * 0.8, rel=0.1)
