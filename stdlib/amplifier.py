@@ -45,6 +45,7 @@ from mechc.cells.springs import design_coil
 from mechc.errors import DesignError
 from mechc.ir.check import Check
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Part, Point, Spring, SynthContext
+from mechc.parts.lever import Lever
 from mechc.physics.closed_form import solve
 from mechc.physics.scene import FAR, N
 
@@ -560,7 +561,15 @@ class Amplifier(Cell):
         tog = by_role["output toggle"][0]
         out = by_role["AMPLIFIER output"][0]
         u = np.broadcast_to(np.asarray(fixed[slider.id], dtype=float), (size,)).copy()
-        theta = np.where(u >= 0.0, d["theta_on"], d["theta_off"])
+        # T's angle on each stop from where the stop and T's lug are (the design's angles at
+        # nominal: a stop cut off its drawing moves them)
+        at = {}
+        for j in part.joints:
+            if j.kind == "contact" and j.a == GROUND and j.b == tog.id:
+                key = "theta_on" if j.normal[0] < 0 else "theta_off"
+                at[key] = Lever.angle_at_face(tog, j.pb, j.pa, j.normal, d[key])
+        theta = np.where(u >= 0.0, at.get("theta_on", d["theta_on"]),
+                         at.get("theta_off", d["theta_off"]))
         rod = next(j for j in part.joints if j.kind == "rod")
         sub = Part([tog, out], [rod])
         poses = solve(sub, {tog.id: theta}, size)

@@ -22,6 +22,7 @@ from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.cells.springs import design_coil
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Spring
+from mechc.parts.lever import Lever
 from mechc.parts.rod import slider_from_rod
 from mechc.physics.closed_form import KinematicsError, Poses
 
@@ -159,18 +160,26 @@ class Memory(Cell):
         xo, a = lever.pivot[0], cs.pb[1] - lever.pivot[1]
         sig_s = (cs.pa[0] + us - xo) / a  # sin of the throw the S face imposes (clockwise)
         sig_r = -(cr.pa[0] + ur - xo) / a  # R: upper bound on sin(throw)
-        sin_a = math.sin(alpha)
+        # the throw at each stop, from where the stops and the lever's point that meets them
+        # are (alpha at nominal: a stop cut off its drawing throws the lever further or less)
+        stops = [j for j in part.joints if j.kind == "contact" and j.a == GROUND
+                 and j.b == lever.id]
+        throw = {j.normal[0] < 0: -Lever.angle_at_face(lever, j.pb, j.pa, j.normal,
+                                                       -alpha if j.normal[0] < 0 else alpha)
+                 for j in stops}
+        sin_hi = np.sin(throw.get(True, alpha))  # clockwise, on
+        sin_lo = np.sin(throw.get(False, -alpha))  # counter-clockwise, off
         on = state > 0.5
-        sin_phi = np.where(on, sin_a, -sin_a)
+        sin_phi = np.where(on, sin_hi, sin_lo)
         set_ = sig_s > 0.0
         reset = sig_r < 0.0
         sin_phi = np.where(~on & ~set_, np.maximum(sin_phi, sig_s), sin_phi)
         sin_phi = np.where(on & ~reset, np.minimum(sin_phi, sig_r), sin_phi)
         new = np.where(set_, 1.0, np.where(reset, 0.0, state))
-        sin_phi = np.where(set_ & ~reset, sin_a, np.where(reset & ~set_, -sin_a, sin_phi))
+        sin_phi = np.where(set_ & ~reset, sin_hi, np.where(reset & ~set_, sin_lo, sin_phi))
         # the faces bind the lever when S asks for more throw than R allows (both pressing,
         # from either side); beyond a stop the input itself is blocked
-        jam = (sig_s > sig_r + 1e-9) | (sig_s > sin_a + 1e-9) | (sig_r < -sin_a - 1e-9)
+        jam = (sig_s > sig_r + 1e-9) | (sig_s > sin_hi + 1e-9) | (sig_r < sin_lo - 1e-9)
         phi = np.arcsin(np.clip(sin_phi, -1, 1))
         poses = Poses()
         poses.u[s_body], poses.u[r_body] = np.array(us, float), np.array(ur, float)

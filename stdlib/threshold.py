@@ -28,6 +28,7 @@ from scipy.optimize import brentq
 from mechc.cells.builder import Builder
 from mechc.cells.cell import Cell
 from mechc.errors import DesignError
+from mechc.geometry.circles import quarter_turn
 from mechc.ir.logic_types import evaluate_type
 from mechc.ir.mechanism import Body, Demand, Joint, Part
 from mechc.physics.closed_form import Poses, solve
@@ -91,9 +92,12 @@ class ThresholdCell(Cell):
         return n_inputs * 2 + (2 if n_inputs == 2 else 4) + 5
 
     @classmethod
-    def design(cls, n_inputs: int, params: dict, stroke: float) -> GeneratorDesign:
+    def design(cls, n_inputs: int, params: dict, stroke: float,
+               angle_margin: float = 0.0) -> GeneratorDesign:
+        """``angle_margin``: degrees of separator transmission angle beyond the limit (robust
+        design asks for it: the angle scatters with the tolerances)."""
         tt = truth_table(params, n_inputs)
-        d = design_generator(tt, stroke_mm=stroke, mu_min_deg=MU_MIN_DEG,
+        d = design_generator(tt, stroke_mm=stroke, mu_min_deg=MU_MIN_DEG + angle_margin,
                              pressure_limit_deg=PRESSURE_LIMIT_DEG)
         if d.kind != "generator":
             raise DesignError(f"THRESHOLD {params}: the function is a {d.kind}; map it to a "
@@ -102,7 +106,7 @@ class ThresholdCell(Cell):
 
     @classmethod
     def synthesise(cls, cid, ctx, n_inputs, params, demand):
-        d = cls.design(n_inputs, params, ctx.stroke)
+        d = cls.design(n_inputs, params, ctx.stroke, ctx.angle_margin)
         return build_part(cid, ctx, n_inputs, d, demand, cls.input_names(n_inputs))
 
     @classmethod
@@ -120,6 +124,10 @@ class ThresholdCell(Cell):
         outside = (phi < lo - CAM_RANGE_TOL) | (phi > hi + CAM_RANGE_TOL) | ~np.isfinite(phi)
         sense = 1.0 if info["follower_primed"] else -1.0
         th = sense * info["swing"] * (y - info["y_design"])
+        err = info.get("profile_error")
+        if err is not None:  # a cam, roller or pivots cut off their drawing (tolerance runs)
+            th = th + contact_error_turn(part, info, err, poses.theta[cam_id], phi, th,
+                                         program, outside)
         back = Part([b for b in part.bodies if b.id in back_ids],
                     [j for j in part.joints if j.kind == "rod" and {j.a, j.b} == back_ids])
         rest = solve(back, {fol_id: np.where(outside, np.nan, th)}, size)
@@ -136,6 +144,69 @@ class ThresholdCell(Cell):
         # the transmission angle of a cam pair is 90 deg minus its pressure angle
         poses.transmission[info["touch_joint"]] = np.where(outside, np.nan, 90.0 - pa)
         return poses
+
+
+def _follower(info: dict) -> Follower:
+    f = info["follower"]
+    return Follower(tuple(f["K"]), f["direction"], f["radius"], f["arm"], info["swing"],
+                    f["roller"], info["follower_primed"])
+
+
+def _rot(a, v):
+    """Vectors (..., 2) turned by angles ``a`` (rad, counter-clockwise)."""
+    c, s = np.cos(a), np.sin(a)
+    return np.stack([c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1]], -1)
+
+
+def contact_error_turn(part: Part, info: dict, err: dict, cam_theta, phi, th,
+                       program: FollowerProgram, outside) -> np.ndarray:
+    """How far (rad, counter-clockwise) the follower turns from its program when the cam pair
+    is made off its drawing: the cam's outline off radially by ``err["mm"]`` at the cam angles
+    ``err["phi"]`` (linear between them), the roller's radius off by ``err["roller_mm"]``, and
+    the cam's pivot K, the follower's pivot Z and the roller's centre on it moved from where the
+    drawing put them (``err["K"]``, ``err["Z"]``, ``err["H"]``, mm, the drawing's values: the
+    part's own are the made ones).
+
+    First order, as every tolerance here: the roller must stay on the cam, so the gap these
+    errors open along the contact's common normal n is closed by turning the follower by
+    gap / (dH/dtheta . n). A perturbed design written as JSON carries ``err`` in this cell's
+    data, so the kinematic proof of that file sees the same cam (its drawn outline stays
+    nominal)."""
+    fol = _follower(info)
+    safe = np.where(outside, info["cam_range"][0], phi)
+    y, dy = program.evaluate(safe)
+    H = fol.roller_centre(y)  # separator frame, crank lengths
+    arm = H - fol.pivot
+    dpsi = (fol.swing if fol.primed else -fol.swing) * dy
+    rel = H - np.asarray(fol.K)
+    tangent = dpsi[..., None] * quarter_turn(arm) - info["orientation"] * quarter_turn(rel)
+    n = quarter_turn(tangent)
+    n = n / np.hypot(n[..., 0], n[..., 1])[..., None]
+    n = np.where(((n * rel).sum(-1) < 0)[..., None], -n, n)  # outwards, cam to roller
+    cam = next(b for b in part.bodies if b.id == info["cam_body"])
+    fol_body = next(b for b in part.bodies if b.id == info["follower_body"])
+    touch = next(j for j in part.joints if j.id == info["touch_joint"])
+    K0, Z0, H0 = (np.asarray(err[k], float) for k in ("K", "Z", "H"))
+    scale = float(np.hypot(*(H0 - Z0))) / fol.arm  # mm per crank length
+    size = np.shape(phi)
+
+    def delta(now, was) -> np.ndarray:
+        return np.stack([np.broadcast_to(np.asarray(now[c], float) - was[c], size)
+                         for c in (0, 1)], -1)
+
+    dK, dZ, dH = delta(cam.pivot, K0), delta(fol_body.pivot, Z0), delta(touch.q, H0)
+    angles = np.asarray(err["phi"], float)
+    radial = 0.0
+    for k, v in enumerate(err["mm"]):  # hat functions: linear between the cam angles
+        radial = radial + np.interp(safe, angles, np.eye(len(angles))[k]) * np.asarray(v)
+    radial = radial + np.asarray(err.get("roller_mm", 0.0))
+    cam_turn = np.broadcast_to(np.asarray(cam_theta, float), size)
+    th_b = np.broadcast_to(np.asarray(th, float), size)
+    pitch_moved = dK - _rot(cam_turn, dK)  # the profile turns about the moved pivot
+    roller_moved = dZ + _rot(th_b, dH - dZ)
+    gap = radial + ((pitch_moved - roller_moved) * n).sum(-1)
+    gain = (quarter_turn(arm) * n).sum(-1) * scale  # mm of normal travel per rad
+    return np.where(outside, 0.0, gap / gain)
 
 
 def build_part(cid: str, ctx, n_inputs: int, d: GeneratorDesign, demand: Demand,

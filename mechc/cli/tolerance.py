@@ -43,8 +43,9 @@ they must move). Pin clearance is lost motion at every pin, taken up the worst w
 solved together (one evaluation of the closed forms over samples x states).
 
 Prints the yield with its 95 % (Wilson) interval, the checks that fail most, each output's
-structural error (scatter of its rest positions against the stroke) and the dimensions that
-matter most (finite differences of the closed forms; regression of the samples' margin).
+structural error (scatter of its rest positions against the stroke), the pairs of parts the
+interference bound says may touch (not counted in the yield) and the dimensions that matter
+most (finite differences of the closed forms; regression of the samples' margin).
 
 processes (--process; explicit --tol/--clearance/--spring-tol override it):
 {procs}
@@ -177,14 +178,15 @@ def robust_design(args: argparse.Namespace):
                                          lambda line: print(f"  tolerance round: {line}",
                                                             file=sys.stderr))
     rows = [(i + 1, f"{r.stroke:g}", f"{r.spring_margin:.3g}", f"{r.overtravel:.0%}",
-             f"{r.result.yield_:.2%}",
+             f"{r.angle_margin:g}", f"{r.result.yield_:.2%}",
              f"[{r.result.ci[0]:.2%}, {r.result.ci[1]:.2%}]",
              r.result.failing[0].key.name + " at " + r.result.failing[0].key.where
              if r.result.failing else "none") for i, r in enumerate(rounds)]
     print(f"robust design for +-{s.tol} mm, pin clearance {s.clearance} mm, springs "
           f"+-{s.spring_tol:.0%}, target yield {s.yield_level:.2%} ({s.samples} samples a "
           "round):")
-    print(table(rows, ["round", "stroke mm", "spring margin", "over-travel", "yield",
+    print(table(rows, ["round", "stroke mm", "spring margin", "over-travel",
+                       "angle margin deg", "yield",
                        "95 % interval", "most frequent failure"]))
     for i, r in enumerate(rounds):
         if r.change:
@@ -192,7 +194,8 @@ def robust_design(args: argparse.Namespace):
     last = rounds[-1]
     if met:
         print(f"  target met: stroke {last.stroke:g} mm, spring margin {last.spring_margin:.3g}"
-              f", over-travel {last.overtravel:.0%} of stroke")
+              f", over-travel {last.overtravel:.0%} of stroke, angle margin "
+              f"{last.angle_margin:g} deg")
     else:
         f = last.result.failing[0] if last.result.failing else None
         print(f"  TARGET NOT MET: yield {last.result.yield_:.2%}"

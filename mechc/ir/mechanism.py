@@ -312,6 +312,8 @@ class SynthContext:
     damping_ratio: float = 0.4
     overtravel: float = 0.02  # fraction of stroke a bar may pass its working range (a stop)
     clearance: float = 1.0  # mm between parts on one plane in every state (interference)
+    angle_margin: float = 0.0  # degrees of transmission angle a cell that can keeps beyond
+    # its design limit (robust design asks the threshold generators for it)
 
     @property
     def bar(self) -> float:

@@ -35,6 +35,22 @@ class Lever(BodyKind):
         return r[0] * c - r[1] * s, r[0] * s + r[1] * c
 
     @classmethod
+    def angle_at_face(cls, body: Body, p, face, normal, guess: float) -> np.ndarray:
+        """The angle (rad ccw from the design pose) at which the lever's point ``p`` lies on
+        the plane through ``face`` with ``normal``: where a stop on the frame catches it; of
+        the two such angles, the one nearer ``guess``. The points may be arrays (a tolerance
+        run's samples), so a stop or a hole cut off its drawing moves the angle it sets."""
+        vx, vy = p[0] - body.pivot[0], p[1] - body.pivot[1]
+        nx, ny = normal
+        a, b = nx * vx + ny * vy, ny * vx - nx * vy  # n . R(theta) v = a cos + b sin
+        rhs = nx * (face[0] - body.pivot[0]) + ny * (face[1] - body.pivot[1])
+        mid = np.arctan2(b, a)
+        half = np.arccos(np.clip(rhs / np.hypot(a, b), -1.0, 1.0))
+        lo, hi = mid - half, mid + half
+        near = lambda t: np.abs(np.angle(np.exp(1j * (t - guess))))  # noqa: E731
+        return np.where(near(lo) <= near(hi), lo, hi)
+
+    @classmethod
     def dyad_anchor(cls, body: Body, joints: list[Joint], bodies: dict[str, Body],
                     poses: Poses):
         return body.pivot, np.asarray(body.pivot[0]), np.asarray(body.pivot[1]), None, None

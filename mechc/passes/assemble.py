@@ -46,6 +46,7 @@ class MechOptions:
     material: str = DEFAULT_MATERIAL  # plate material (mechc/cells/materials.py)
     spring_margin: float = 1.3  # spring preload >= this x what it must move (SynthContext)
     overtravel: float = 0.02  # over-travel stops, fraction of stroke beyond the working range
+    angle_margin: float = 0.0  # degrees of transmission angle beyond the limit (SynthContext)
 
 
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
@@ -54,7 +55,7 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
     mat = material(opts.material)
     ctx = SynthContext(stroke=opts.stroke, density=mat.density, material=mat.name,
                        clearance=opts.clearance, margin=opts.spring_margin,
-                       overtravel=opts.overtravel)
+                       overtravel=opts.overtravel, angle_margin=opts.angle_margin)
     S, w = ctx.stroke, ctx.bar
     order = [c.id for c in nl.topo_cells()]
     cells = {c.id: c for c in nl.cells.values()}

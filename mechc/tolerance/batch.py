@@ -27,13 +27,14 @@ from mechc.parts.poses import Poses
 from mechc.parts.pushrod import NetRod
 from mechc.parts.rod import slider_from_rod
 from mechc.physics.closed_form import position
-from mechc.physics.evaluate import signal_of
+from mechc.physics.evaluate import evaluate, signal_of
 from mechc.physics.measures import (
     MIN_SINGULAR_MARGIN_DEG,
     MIN_SPRING_MARGIN,
     MIN_TRANSMISSION_DEG,
 )
 from mechc.physics.measures import _where as where_of  # the checks' places, as the proof's
+from mechc.tolerance.clearance import displacement, radius
 from mechc.tolerance.cones import plan
 from mechc.tolerance.dimensions import Dim, perturb_part
 from mechc.tolerance.states import States
@@ -73,6 +74,7 @@ class ChunkResult:
     checks: dict[CheckKey, np.ndarray] = field(default_factory=dict)  # key -> (M,)
     rest_pos: dict[str, np.ndarray] = field(default_factory=dict)  # output -> (M, n_rest)
     worst_dev: dict[str, np.ndarray] = field(default_factory=dict)  # output -> (M,) fraction
+    moves: dict[str, np.ndarray] = field(default_factory=dict)  # body -> (M,) mm, its most
 
 
 class Batch:
@@ -104,6 +106,8 @@ class Batch:
             self.geo_by_part.setdefault(dims[k].part, []).append(k)
         self.mult = {o: np.bincount(ss.inv, minlength=ss.size).astype(float)
                      for o, ss in self.plan.sets.items()}
+        self.radii = {b.id: radius(b) for b in self.bodies.values()}
+        self._nominal: Solved | None = None
         for rods in self.plan.rods_to.values():
             for _, r in rods:
                 if self.bodies[r.driver].kind != "slider":
@@ -192,12 +196,26 @@ class Batch:
     def signals(self, delta: np.ndarray) -> dict[str, np.ndarray]:
         return self.solve(delta).signals
 
+    @property
+    def size(self) -> int:
+        """The proof states each sample is solved in (what ``signals`` gives per sample)."""
+        return self.states.size
+
+    def rest_reference(self, o: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The states where output ``o`` is at rest and cared for, what the spec wants there,
+        and the lost motion of the pins there (fraction of stroke)."""
+        st = self.states
+        want = st.rest_want[o]
+        at = np.flatnonzero(want != 2)  # DC
+        return at, want[at].astype(float), self.lost.get(o, np.zeros(st.size))[at]
+
     # ---- the checks ---------------------------------------------------------------------
     def run(self, delta: np.ndarray) -> ChunkResult:
         solved = self.solve(delta)
         sig = solved.signals
         M, S, st = delta.shape[0], self.states.size, self.states
         res = ChunkResult()
+        self._moves(solved, M, res)
         nr, ne, ns = st.n_rest, st.n_edges, st.samples
         for o, v in sig.items():
             lost = self.lost.get(o, np.zeros(S))
@@ -233,6 +251,24 @@ class Batch:
                 res.checks[CheckKey(c.name, c.where, c.limit, c.sense, c.unit)] = np.full(
                     M, float(c.value))
         return res
+
+    def _moves(self, solved: Solved, M: int, res: ChunkResult) -> None:
+        """How far each body moves from its nominal poses, per sample (its most over its
+        states): what the interference bound (``mechc.tolerance.clearance``) reads."""
+        if self._nominal is None:
+            self._nominal = self.solve(np.zeros((1, len(self.dims))))
+        for owner, poses in solved.poses.items():
+            part = self.mech.inputs[owner[3:]] if owner.startswith("in:") \
+                else self.mech.cells[owner]
+            res.moves.update(displacement(part.bodies, poses, self._nominal.poses[owner], M,
+                                          self.plan.sets[owner].size, self.radii))
+
+    def nominal_poses(self) -> list[Poses]:
+        """Every body's poses in every proof state at nominal (what the interference check
+        measures the nominal gaps on)."""
+        st = self.states
+        values = {n: st.values[k] for k, n in enumerate(st.names)}
+        return [evaluate(self.mech, self.lib, self.types, values)]
 
     def _angles(self, poses: Poses, M: int, S: int, res: ChunkResult) -> None:
         for name, data, limit in (("transmission angle", poses.transmission,

@@ -2,7 +2,9 @@
 
 A dimension is one number of the geometry a maker cuts, drills or buys: a coordinate of a
 joint's point (a pin hole, a slot's end, a contact face, a stop on the frame), a rod's length,
-a lever's pivot, a spring's rate and preload, a part's outline. :func:`perturb` gives the
+a lever's pivot, a spring's rate and preload, a part's outline, a threshold generator's cam
+outline (its radial error per segment of the follower program) and roller radius (data its
+cell's kinematics reads: ``profile_error``). :func:`perturb` gives the
 mechanism with every dimension at a value of its own; a value may be an array (one entry per
 sample and state of a tolerance run), which the closed forms (``mechc.physics.closed_form`` and
 the part kinds) carry through as they carry states, so many perturbed designs are solved in one
@@ -55,7 +57,7 @@ def _parts(mech: Mechanism) -> list[tuple[str, str, Part]]:
 def _pin_point(j: Joint, attr: str) -> bool:
     """Points where a pin sits in a hole (or a slot): the joints with play."""
     return ((j.kind == "pin" and attr == "pa") or (j.kind == "rod" and attr in ("pa", "pb"))
-            or (j.kind == "groove" and attr == "q"))
+            or (j.kind in ("groove", "touch") and attr == "q"))
 
 
 def dimensions(mech: Mechanism) -> list[Dim]:
@@ -78,9 +80,9 @@ def dimensions(mech: Mechanism) -> list[Dim]:
                 dims.append(Dim(f"{b.id}.length", owner, "rod length", "mm", rod_length[b.id],
                                 key, "body", i, "length", -1))
         for i, j in enumerate(part.joints):
-            if j.kind == "touch":  # a cam or roller: its cell's own kinematics (not modelled)
-                continue
-            for attr in POINT_ATTRS:
+            for attr in (("q",) if j.kind == "touch" else POINT_ATTRS):
+                # a cam's or roller's contact: only the roller's axle hole is a point of its
+                # own (the outline is its cell's data: ``_cam_dims``)
                 p = getattr(j, attr)
                 if p is None:
                     continue
@@ -93,11 +95,40 @@ def dimensions(mech: Mechanism) -> list[Dim]:
             if j.kind == "rod" and j.length is not None:
                 dims.append(Dim(f"{j.id}.length", owner, "rod length", "mm", float(j.length),
                                 key, "joint", i, "length", -1))
+        dims += _cam_dims(key, owner, part)
         for i, s in enumerate(part.springs):
             dims.append(Dim(f"{s.id} rate", owner, "spring rate", "fraction", float(s.rate),
                             key, "spring", i, "rate", -1))
             dims.append(Dim(f"{s.id} preload", owner, "spring preload", "fraction",
                             float(s.preload), key, "spring", i, "preload", -1))
+    return dims
+
+
+def cam_angles(info: dict) -> list[float]:
+    """Where a threshold generator's cam outline gets a radial error of its own: the middle
+    of each segment of its follower program (each dwell and each rise or return) over the
+    working range and its 5 degree dwells; linear between them (``stdlib/threshold.py``)."""
+    lo, hi = info["cam_range"]
+    ends = [lo - np.radians(5.0)] + [e for band in info["bands"] for e in band
+                                     if lo - np.radians(5.0) < e < hi + np.radians(5.0)]
+    ends = sorted(set(ends + [hi + np.radians(5.0)]))
+    return [float((a + b) / 2) for a, b in zip(ends, ends[1:])]
+
+
+def _cam_dims(key: str, owner: str, part: Part) -> list[Dim]:
+    """A threshold generator's cam outline (radial error at each of :func:`cam_angles`) and
+    its roller's radius: data of the cell's own kinematics, not joint points."""
+    info = part.data.get("threshold")
+    if not info or "cam_range" not in info:
+        return []
+    err = info.get("profile_error", {})
+    was = err.get("mm", [])
+    cell = info["cam_body"].rsplit(".", 1)[0]
+    dims = [Dim(f"{cell}.cam.r{k}", owner, "cam profile", "mm",
+                float(was[k]) if k < len(was) else 0.0, key, "data", k, "profile", -1)
+            for k in range(len(cam_angles(info)))]
+    dims.append(Dim(f"{cell}.roller.radius", owner, "roller radius", "mm",
+                    float(err.get("roller_mm", 0.0)), key, "data", 0, "roller", -1))
     return dims
 
 
@@ -155,9 +186,37 @@ def perturb_part(part: Part, changes: list[tuple[Dim, object]], springs: bool = 
             bodies[i] = _body(bodies[i], ch, scalar, absolute)
         elif obj == "joint":
             joints[i] = _changed(joints[i], ch, absolute)
-        elif springs:
+        elif obj == "spring" and springs:
             sprs[i] = _spring(sprs[i], ch)
-    return Part(bodies, joints, sprs, part.terminals, part.data)
+    data = part.data
+    if "cam_range" in part.data.get("threshold", {}):  # its cam pair measures every change
+        data = _cam_error(part, [(d, v) for d, v in changes if d.obj == "data"], absolute)
+    return Part(bodies, joints, sprs, part.terminals, data)
+
+
+def _cam_error(part: Part, changes: list[tuple[Dim, object]], absolute: bool) -> dict:
+    """The cell's data with the cam's error (``profile_error``, which the THRESHOLD cell's
+    kinematics reads): the outline's radial errors, the roller's, and the drawing's pivots and
+    roller centre, from which the part's own (perturbed) ones are measured."""
+    info = dict(part.data["threshold"])
+    old = info.get("profile_error")
+    angles = cam_angles(info)
+    mm: list[object] = list(old["mm"]) if old else [0.0] * len(angles)
+    roller: object = old.get("roller_mm", 0.0) if old else 0.0
+    for d, v in changes:
+        if d.attr == "profile":
+            mm[d.index] = v if absolute else mm[d.index] + v
+        else:
+            roller = v if absolute else roller + v
+    if old:
+        ref = {k: old[k] for k in ("K", "Z", "H")}
+    else:
+        bodies = {b.id: b for b in part.bodies}
+        touch = next(j for j in part.joints if j.id == info["touch_joint"])
+        ref = {"K": list(bodies[info["cam_body"]].pivot),
+               "Z": list(bodies[info["follower_body"]].pivot), "H": list(touch.q)}
+    info["profile_error"] = {"phi": angles, "mm": mm, "roller_mm": roller, **ref}
+    return {**part.data, "threshold": info}
 
 
 def _changed(obj, changes: list[tuple[Dim, object]], absolute: bool = False):

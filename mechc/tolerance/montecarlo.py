@@ -20,10 +20,11 @@ from mechc.cells.library import Library
 from mechc.errors import UsageError
 from mechc.ir.design import Design
 from mechc.ir.spec import Spec
+from mechc.physics.interference import Interference
 from mechc.tolerance.batch import Batch, CheckKey
+from mechc.tolerance.clearance import DRAWING, PairRisk, Risk
 from mechc.tolerance.dimensions import Dim, dimensions
 from mechc.tolerance.sensitivity import (
-    Jacobian,
     Ranked,
     by_owner,
     jacobian,
@@ -85,6 +86,11 @@ class ToleranceResult:
     per_owner: dict[str, float]
     sample_pass: np.ndarray  # (N,) bool
     fails: dict[str, np.ndarray] = field(default_factory=dict)  # check name -> (N,) failed
+    # the interference bound (mechc.tolerance.clearance): pairs held to a gap at nominal and
+    # the samples where they may touch; samples where any may (not counted in the yield)
+    interference: list[PairRisk] = field(default_factory=list)
+    interference_samples: int = 0
+    interference_passing: int = 0  # of them, samples that pass every check
     seconds: dict[str, float] = field(default_factory=dict)
 
     @property
@@ -116,17 +122,38 @@ def draw(dims: list[Dim], s: ToleranceSettings, n: int | None = None) -> np.ndar
 
 def prepare(design: Design, lib: Library, s: ToleranceSettings):
     """The batch solver of ``design`` with its pins' lost motion, and the derivatives (a
-    sequential design: its walks' batch, no derivatives, no pin play)."""
+    sequential design: its walks' batch, the derivatives taken at every point of its walks)."""
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
     dims = dimensions(design.mechanism)
+    batch: Batch | SequentialBatch
     if design.sequential is not None or not isinstance(design.spec, Spec):
-        return SequentialBatch(design, lib, dims, s.proof_tolerance), Jacobian(dims, {})
-    states = proof_states(design.spec)
-    batch = Batch(design, lib, states, dims, s.proof_tolerance)
-    jac = jacobian(batch, s.chunk_states)
+        batch = SequentialBatch(design, lib, dims, s.proof_tolerance)
+        jac = jacobian(batch, per=SEQUENTIAL_CHUNK)
+    else:
+        batch = Batch(design, lib, proof_states(design.spec), dims, s.proof_tolerance)
+        jac = jacobian(batch, s.chunk_states)
     batch.lost = lost_motion(jac, s.clearance) if s.clearance > 0 else {}
     return batch, jac
+
+
+def nominal_gaps(batch: Batch | SequentialBatch, risk: Risk, s: ToleranceSettings
+                 ) -> Interference:
+    """The interference check of the nominal design over the run's states, measured out to
+    the largest gap the samples' moves could close."""
+    finite = [float(v[np.isfinite(v)].max()) for vs in risk.moves.values() for v in vs
+              if np.isfinite(v).any()]
+    reach = 2 * (max(finite, default=0.0) + DRAWING * s.tol + s.clearance / 2)
+    inter = Interference(batch.mech, clearance=reach)
+    for poses in batch.nominal_poses():
+        inter.add(poses)
+    return inter
+
+
+def interference_risk(batch: Batch | SequentialBatch, risk: Risk, s: ToleranceSettings,
+                      N: int) -> tuple[list[PairRisk], np.ndarray]:
+    """Pairs on one plane and the samples the bound says may touch them."""
+    return risk.pairs(nominal_gaps(batch, risk, s), s.tol, s.clearance, N)
 
 
 def run(design: Design, lib: Library, s: ToleranceSettings,
@@ -147,6 +174,7 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     fail_count: dict[CheckKey, int] = {}
     fail_worst: dict[CheckKey, float] = {}
     rest_pos: dict[str, list[np.ndarray]] = {}
+    risk = Risk(design.mechanism)
     stroke = design.mechanism.ctx.stroke
     for start in range(0, N, per):
         chunk = X[start:start + per]
@@ -171,6 +199,7 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
         margins.append((s.proof_tolerance - worst) * stroke)
         for o, v in res.rest_pos.items():
             rest_pos.setdefault(o, []).append(v)
+        risk.add(res.moves, len(chunk))
         if progress is not None:
             progress(min(N, start + per), N)
     t2 = time.perf_counter()
@@ -194,9 +223,11 @@ def run(design: Design, lib: Library, s: ToleranceSettings,
     # allowance, so a few of them do not outweigh the trend of all the others
     ranked = rank(jac, tolerances(dims, s), stroke, X,
                   np.maximum(margin, -s.proof_tolerance * stroke))
+    pairs, at_risk = interference_risk(batch, risk, s, N)
     t3 = time.perf_counter()
     return ToleranceResult(
         s, dims, N, k, wilson(k, N), failing, nominal_margin, structural, ranked,
-        by_owner(ranked), sample_pass, by_name,
+        by_owner(ranked), sample_pass, by_name, pairs, int(at_risk.sum()),
+        int((at_risk & sample_pass).sum()),
         {"derivatives": round(t1 - t0, 4), "samples": round(t2 - t1, 4),
          "analysis": round(t3 - t2, 4), "total": round(t3 - t0, 4)})

@@ -26,6 +26,13 @@ def to_json(r: ToleranceResult, source: str, top: int = 30) -> dict:
                            for f in r.failing],
         "nominal_output_margin_mm": {o: round(v, 6) for o, v in r.nominal_margin_mm.items()},
         "structural_error": [e.to_json() for e in r.structural],
+        "interference_bound": {
+            "samples_may_touch": r.interference_samples,
+            "passing_samples_may_touch": r.interference_passing,
+            "pairs": [{"bodies": [p.a, p.b], "plane": p.layer,
+                       "nominal_gap_mm": round(p.nominal_gap_mm, 6), "samples": p.samples,
+                       "smallest_bound_mm": None if abs(p.worst_mm) == float("inf")
+                       else round(p.worst_mm, 6)} for p in r.interference[:top]]},
         "sensitivity": [{"dimension": x.dim.name, "owner": x.dim.owner, "what": x.dim.what,
                          "nominal": round(x.dim.nominal, 6),
                          "position_effect_mm": round(x.position_mm, 6),
@@ -58,8 +65,17 @@ def summary(r: ToleranceResult, name: str, top: int = 10) -> str:
                   table(rows, ["output", "spread", "extremes", "lost motion", "mid margin",
                                "stroke"])]
     else:
-        lines += ["", "a sequential design: no structural error, derivatives or pin play "
-                  "(its walks are proven per sample; dimensions ranked by regression only)"]
+        lines += ["", "no output is cared for at rest: no structural error"]
+    near = [p for p in r.interference if p.samples]
+    lines += ["", f"interference (a bound, not counted in the yield): {len(r.interference)} "
+              f"pairs on one plane come near enough at nominal for the samples' moves to "
+              f"matter; the bound says some may touch in {r.interference_samples} samples, "
+              f"{r.interference_passing} of them passing every check"]
+    if near:
+        rows = [(f"{p.a} / {p.b}", p.layer, f"{p.nominal_gap_mm:.3f}", p.samples,
+                 f"{p.worst_mm:.3f}") for p in near[:top]]
+        lines.append(table(rows, ["pair", "plane", "gap at nominal", "samples at risk",
+                                  "smallest bound"]))
     rows = [(x.dim.name, x.dim.owner, x.dim.what, f"{x.position_mm:.4f}",
              f"{x.margin_coef:+.4f}") for x in r.ranked[:top]]
     lines += ["", "dimensions that matter most (output movement at tolerance, mm; regression "

@@ -14,8 +14,12 @@ What each failing check asks for:
   part scales with it);
 - *SET and RESET together* (a MEMORY binds: its two faces overlap by the tolerances): a
   longer stroke too;
-- *transmission angle*, *distance from toggle*: angles do not change with scale, and link
-  proportions are each cell's own design: reported, not cured.
+- *transmission angle* at a threshold generator (its separator designed to meet 45 deg
+  exactly, which half the samples then miss): ask the generators' synthesis for the angle the
+  samples lost beyond the limit, plus a degree, as margin (``angle_margin``: the separator's
+  proportions change);
+- *transmission angle* elsewhere, *distance from toggle*: angles do not change with scale,
+  and other cells' proportions are their own design: reported, not cured.
 """
 
 from __future__ import annotations
@@ -36,6 +40,7 @@ from mechc.tolerance.sequential import JAM as MEMORY_BINDS
 MAX_ROUNDS = 6
 MAX_OVERTRAVEL = 0.12
 MAX_STROKE_FACTOR = 3.0
+MAX_ANGLE_MARGIN = 15.0  # degrees beyond the 45 degree limit a generator is asked for
 SPRING_CHECK = 1.15  # the spring force margin design check (mechc.physics.measures)
 JAM = "unsolvable states (binding or cannot assemble)"
 
@@ -45,6 +50,7 @@ class Round:
     stroke: float
     spring_margin: float
     overtravel: float
+    angle_margin: float
     result: ToleranceResult
     change: str  # what the next round changes, and why ("" on the last)
 
@@ -56,16 +62,17 @@ def robust_compile(spec: Spec, opts: CompileOptions, lib: Library, s: ToleranceS
     the target was met."""
     mech = opts.mech
     stroke, margin, over = mech.stroke, mech.spring_margin, mech.overtravel
+    angle = mech.angle_margin
     rounds: list[Round] = []
     for _ in range(MAX_ROUNDS):
         o = replace(opts, mech=replace(mech, stroke=stroke, spring_margin=margin,
-                                       overtravel=over))
+                                       overtravel=over, angle_margin=angle))
         design = compile_spec(spec, o, lib)
         r = run(design, lib, s)
-        rounds.append(Round(stroke, margin, over, r, ""))
+        rounds.append(Round(stroke, margin, over, angle, r, ""))
         if progress is not None:
             progress(f"stroke {stroke:g} mm, spring margin {margin:.3g}, over-travel "
-                     f"{over:.0%}: yield {r.yield_:.2%}")
+                     f"{over:.0%}, angle margin {angle:g} deg: yield {r.yield_:.2%}")
         if r.yield_ >= s.yield_level:
             return design, rounds, True
         names: dict[str, Failing] = {}
@@ -97,7 +104,17 @@ def robust_compile(spec: Spec, opts: CompileOptions, lib: Library, s: ToleranceS
                        f"nothing binds, or a MEMORY's SET and RESET overlap, in "
                        f"{int(off.sum())} samples)")
             stroke = round(stroke * 1.25, 3)
-        if not why:  # nothing this loop can change (angles) or every limit reached
+        generators = {c.id for c in design.netlist.cells.values() if c.cell == "threshold"}
+        low = [f for f in r.failing if f.key.name == "transmission angle"
+               and f.key.where in generators and np.isfinite(f.worst)]
+        if low and angle < MAX_ANGLE_MARGIN:
+            short = max(f.key.limit - f.worst for f in low)
+            new = min(MAX_ANGLE_MARGIN, float(np.ceil(angle + short + 1.0)))
+            why.append(f"angle margin {angle:g} -> {new:g} deg (threshold generators' "
+                       f"transmission angle down to {min(f.worst for f in low):.3g} deg "
+                       f"in {max(f.count for f in low)} samples)")
+            angle = new
+        if not why:  # nothing this loop can change (other angles) or every limit reached
             return design, rounds, False
         rounds[-1].change = "; ".join(why)
     return design, rounds, False

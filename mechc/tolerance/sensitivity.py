@@ -18,6 +18,7 @@ import numpy as np
 
 from mechc.tolerance.batch import Batch
 from mechc.tolerance.dimensions import Dim
+from mechc.tolerance.sequential import SequentialBatch
 
 H_MM = 1e-3  # finite-difference step: far above rounding (1e-12 mm), far below any tolerance
 MIN_SAMPLES_PER_DIM = 5  # fewer samples than this per dimension: no regression (it over-fits)
@@ -32,12 +33,14 @@ class Jacobian:
     d: dict[str, np.ndarray]  # output -> (D, S)
 
 
-def jacobian(batch: Batch, chunk_states: int = 1 << 16) -> Jacobian:
-    D, S = len(batch.dims), batch.states.size
+def jacobian(batch: Batch | SequentialBatch, chunk_states: int = 1 << 16,
+             per: int | None = None) -> Jacobian:
+    """``per``: dimensions moved in one evaluation (default: ``chunk_states`` states)."""
+    D, S = len(batch.dims), batch.size
     base = batch.signals(np.zeros((1, D)))
     out = {o: np.zeros((D, S)) for o in base}
     geo = batch.geo
-    per = max(1, chunk_states // S)
+    per = per or max(1, chunk_states // S)
     for s in range(0, len(geo), per):
         ks = geo[s:s + per]
         delta = np.zeros((len(ks), D))
@@ -47,6 +50,10 @@ def jacobian(batch: Batch, chunk_states: int = 1 << 16) -> Jacobian:
             out[o][ks] = (v - base[o]) / H_MM
     for o in out:  # a state the nominal design cannot solve has no derivative
         out[o] = np.where(np.isfinite(out[o]), out[o], 0.0)
+        if isinstance(batch, SequentialBatch):
+            # only where the walks judge the output (at rest, or holding): mid-switch a
+            # MEMORY's throw is a jump, whose finite difference says when, not how far
+            out[o][:, ~batch.judged(o)] = 0.0
     return Jacobian(batch.dims, out)
 
 
@@ -77,7 +84,7 @@ def rank(jac: Jacobian, tols: np.ndarray, stroke: float, deltas: np.ndarray | No
     """Dimensions by how far each alone moves an output at its tolerance (largest first); the
     regression of the samples' margin on their deltas alongside, where samples are given."""
     D = len(jac.dims)
-    pos = np.zeros(D)  # no derivatives (a sequential design): zero, ranked by regression
+    pos = np.zeros(D)  # no derivatives (none given): zero, ranked by regression
     for J in jac.d.values():
         pos = np.maximum(pos, np.abs(J).max(axis=1) * tols * stroke)
     coef = np.zeros(D)

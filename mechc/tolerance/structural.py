@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from mechc.logic.cubes import DC
 from mechc.tolerance.batch import Batch
+from mechc.tolerance.sequential import SequentialBatch
 
 
 @dataclass
@@ -33,26 +33,28 @@ class OutputError:
                 "at_yield": self.yield_level}
 
 
-def structural_error(batch: Batch, rest_pos: dict[str, np.ndarray],
+def structural_error(batch: Batch | SequentialBatch, rest_pos: dict[str, np.ndarray],
                      nominal_pos: dict[str, np.ndarray], yield_level: float) -> list[OutputError]:
-    """``rest_pos``: per output the (N, rest states) signals of every sample; ``nominal_pos``:
-    (1, rest states) of the nominal design."""
-    st = batch.states
+    """``rest_pos``: per output the (N, rest points) signals of every sample at the points
+    ``batch.rest_reference`` names (a combinational design's rest states, a sequential one's
+    step ends); ``nominal_pos``: (1, rest points) of the nominal design."""
     S = batch.mech.ctx.stroke
     out = []
     for o, pos in rest_pos.items():
-        want = st.rest_want[o]
-        care = want != DC
-        if not care.any():
+        at, want, lost = batch.rest_reference(o)
+        if not len(at):
             continue
-        lost = batch.lost.get(o, np.zeros(st.size))[:st.n_rest][care]
-        dev = (pos[:, care] - nominal_pos[o][0, care][None, :]) * S
+        if pos.shape[1] != len(at):  # a combinational batch keeps every rest state
+            pos = pos[:, at]
+        nom = nominal_pos[o][0]
+        nom = nom[at] if len(nom) != len(at) else nom
+        dev = (pos - nom[None, :]) * S
         dev = np.where(np.isfinite(dev), dev, np.nan)
         lo_q, hi_q = (1 - yield_level) / 2, (1 + yield_level) / 2
         with np.errstate(invalid="ignore"):
-            mid = (0.5 - np.abs(pos[:, care] - want[care][None, :]) - lost[None, :]) * S
+            mid = (0.5 - np.abs(pos - want[None, :]) - lost[None, :]) * S
         mid = np.where(np.isfinite(mid), mid, -np.inf).min(axis=1)
-        nom_mid = float(((0.5 - np.abs(nominal_pos[o][0, care] - want[care]) - lost) * S).min())
+        nom_mid = float(((0.5 - np.abs(nom - want) - lost) * S).min())
         flat = dev[np.isfinite(dev)]
         spread = (float(np.quantile(flat, lo_q)), float(np.quantile(flat, hi_q))) if flat.size \
             else (np.nan, np.nan)
