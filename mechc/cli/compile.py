@@ -27,7 +27,7 @@ from mechc.cli.common import (
 )
 from mechc.cli.tolerance import robust_design, robust_options, wants_robust
 from mechc.errors import EXIT_FAILED, EXIT_OK, UsageError
-from mechc.frontends import SPEC_SUFFIXES
+from mechc.frontends import SPEC_SUFFIXES, check_spec_path
 from mechc.ir.design import Design
 from mechc.proofs import ProofSettings, prove
 from mechc.proofs.kinematic import EXHAUSTIVE_MAX_INPUTS
@@ -81,6 +81,7 @@ KINEMATIC_AT_COMPILE_MAX = 1_000_000
 
 
 def run(args: argparse.Namespace) -> int:
+    check_spec_path(args.spec)  # a directory or a design given as the spec: say so first
     out = args.output or str(Path(args.spec).with_suffix(".json"))
     check_output(out, "output", [("spec", args.spec)])
     stages = StageProgress("compile", enabled=not args.quiet)

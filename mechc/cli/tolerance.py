@@ -93,9 +93,9 @@ def settings_from(args: argparse.Namespace) -> ToleranceSettings:
 
 def run_command(args: argparse.Namespace) -> int:
     s = settings_from(args)
-    if not args.design.lower().endswith(".json"):
-        raise UsageError(f"{args.design}: expected a compiled design (.json); compile the spec "
-                         "first with `mechc compile`")
+    if not args.design.lower().endswith((".json", ".json.gz")):
+        raise UsageError(f"{args.design}: expected a compiled design (.json or .json.gz); "
+                         "compile the spec first with `mechc compile`")
     if args.json:
         check_output(args.json, "report", [("design", args.design)])
     if args.chart:

@@ -15,7 +15,7 @@ from mechc.frontends.pla import parse_pla_file
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import OutputSpec, Spec
 
-__all__ = ["FRONT_ENDS", "OutputSpec", "SPEC_SUFFIXES", "Spec", "load_spec"]
+__all__ = ["FRONT_ENDS", "OutputSpec", "SPEC_SUFFIXES", "Spec", "check_spec_path", "load_spec"]
 
 #: Spec file suffix -> the front end that parses it (a new format: a module here and a line).
 FRONT_ENDS: dict[str, Callable[[str], Spec | SeqSpec]] = {
@@ -29,14 +29,25 @@ FRONT_ENDS: dict[str, Callable[[str], Spec | SeqSpec]] = {
 SPEC_SUFFIXES = tuple(FRONT_ENDS)
 
 
-def load_spec(path: str | Path) -> Spec | SeqSpec:
-    """Parse a spec file, choosing the front end by suffix."""
+def check_spec_path(path: str | Path) -> Callable[[str], Spec | SeqSpec]:
+    """The front end for ``path``, or the error a user should see first: a directory or an
+    unknown suffix (a compiled design given where a spec belongs is named as such), before a
+    command looks at its output paths (why: "refusing to overwrite the spec x.json" hid that
+    x.json was a design, not a spec)."""
     p = Path(path)
     if p.is_dir():
         raise UsageError(f"{p}: is a directory, expected a spec file "
                          f"({', '.join(SPEC_SUFFIXES)})")
     suffix = p.suffix.lower()
     if suffix in FRONT_ENDS:
-        return FRONT_ENDS[suffix](str(p))
+        return FRONT_ENDS[suffix]
+    hint = ""
+    if p.name.lower().endswith((".json", ".json.gz")):
+        hint = " (a .json file is a compiled design, not a spec: prove it with `mechc simulate`)"
     raise SpecError(str(p), 1, 1, f"unknown spec format '{suffix or p.name}': expected one of "
-                    f"{', '.join(SPEC_SUFFIXES)}")
+                    f"{', '.join(SPEC_SUFFIXES)}{hint}")
+
+
+def load_spec(path: str | Path) -> Spec | SeqSpec:
+    """Parse a spec file, choosing the front end by suffix."""
+    return check_spec_path(path)(str(path))
