@@ -1,6 +1,9 @@
 """Peers in the same run: the kinematic level against pylinkage on one four-bar
 (:mod:`mechc.bench.fourbar`), and the dynamic level against a bare pymunk scene of the same
 bodies and joints.
+
+``python -m mechc.bench.peers`` runs the four-bar figures alone (seconds, not the whole speed
+benchmark) and ends in the same ``name: value`` lines.
 """
 
 from __future__ import annotations
@@ -14,6 +17,13 @@ from mechc.proofs.settings import dyn_settings
 
 def peers(b: Bench, c: Circuit) -> None:
     b.say("\n== peers in the same run ==")
+    fourbar_peers(b)
+    dynamic_peer(b, c)
+
+
+def fourbar_peers(b: Bench) -> None:
+    """The kinematic level against pylinkage on one four-bar, and the positions-only floors
+    (``kinematic_vs_pylinkage`` and the figures beside it)."""
     try:
         r = compare()
     except ModuleNotFoundError as e:
@@ -46,7 +56,10 @@ def peers(b: Bench, c: Circuit) -> None:
             b.row(section="fourbar", circuit="four-bar", level=lvl, cases=r.positions,
                   seconds=(r.positions / rate) if rate else "",
                   error_fraction=r.max_difference_mm)
-    # dynamic level against a bare pymunk scene of the same bodies and joints
+
+
+def dynamic_peer(b: Bench, c: Circuit) -> None:
+    """The dynamic level against a bare pymunk scene of the same bodies and joints."""
     d = c.design
     st = dyn_settings(d)
     name = d.spec.inputs[0]
@@ -71,3 +84,18 @@ def peers(b: Bench, c: Circuit) -> None:
     b.row(section="joint_step", circuit=c.name, level="dynamic", variant="bare pymunk",
           steps=r.steps, seconds=t_bare)
 
+
+
+def main() -> int:
+    """The four-bar peer figures alone."""
+    from mechc.cells.library import load_library
+
+    b = Bench(load_library(), quick=True)
+    fourbar_peers(b)
+    for k, v in b.summary.items():
+        print(f"{k}: {v}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -10,6 +10,7 @@ this module always runs first.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol
@@ -18,7 +19,7 @@ import numpy as np
 import pymunk
 
 from mechc.ir.mechanism import GROUND, Body, Joint, Point
-from mechc.parts.poses import Poses, cos_sin
+from mechc.parts.poses import Poses
 
 N = 1000.0  # newtons -> pymunk force units (kg mm / s^2)
 
@@ -57,10 +58,24 @@ def unit(v):
     return (v[0] / n, v[1] / n)
 
 
+def is_number(v) -> bool:
+    """``v`` is one number (not an array of them): Python and numpy floats without a numpy
+    call, as the closed forms ask this of every dimension on every solve."""
+    return isinstance(v, (float, int)) or np.ndim(v) == 0
+
+
+def sized(x, size: int):
+    """``x`` over ``size`` states: itself when it already has that shape (no numpy call),
+    else a read-only broadcast view."""
+    return x if getattr(x, "shape", None) == (size,) else np.broadcast_to(x, (size,))
+
+
 def side_of(v):
     """The sign of ``v`` with 0 read as +1 (a branch chosen at the design pose): a float for a
     number, an array where the dimensions are arrays (``mechc.tolerance`` perturbs them per
     sample)."""
+    if isinstance(v, (float, int)):
+        return -1.0 if v < 0 else (1.0 if v >= 0 else math.nan)
     if np.ndim(v) == 0:
         return float(np.sign(v)) or 1.0
     return np.where(np.asarray(v) < 0, -1.0, 1.0)
@@ -135,6 +150,8 @@ def placed_key(body: Body | None, p: Point) -> tuple:
     """The key of a design point of ``body``; a point given as arrays (one value per sample
     of a tolerance run) is keyed by the arrays' identity."""
     bid = GROUND if body is None else body.id
+    if isinstance(p[0], (float, int)) and isinstance(p[1], (float, int)):
+        return (bid, float(p[0]), float(p[1]))
     if np.ndim(p[0]) or np.ndim(p[1]):
         return (bid, id(p[0]), id(p[1]))
     return (bid, float(p[0]), float(p[1]))
@@ -143,14 +160,34 @@ def placed_key(body: Body | None, p: Point) -> tuple:
 def placed_position(body: Body | None, poses: Poses, p: Point) -> Coords:
     """``position``, reusing the point where a closed form of this solve placed it."""
     hit = poses.placed.get(placed_key(body, p))
-    return hit if hit is not None else position(body, poses, p)
+    return (hit[0], hit[1]) if hit is not None else position(body, poses, p)
+
+
+def rotate(rx, ry, c, s, centre) -> Coords:
+    """centre + R·(rx, ry) for the cosines ``c`` and sines ``s`` of the states: the terms of
+    an arm component that is exactly 0 (a number) are skipped, which gives the same values
+    (an arm along an axis is common: it saves two of the eight array passes)."""
+    if is_number(rx) and is_number(ry) and (rx == 0 or ry == 0):
+        if rx == 0:
+            x, y = ry * s, ry * c
+            np.subtract(centre[0], x, out=x)
+        else:
+            x, y = rx * c, rx * s
+            x += centre[0]
+        y += centre[1]
+        return x, y
+    x, y = rx * c, rx * s
+    x -= ry * s
+    y += ry * c
+    x += centre[0]
+    y += centre[1]
+    return x, y
 
 
 def turned(body: Body, poses: Poses, p) -> Coords:
     """Displacement of ``p`` on a body turning about its pivot by ``poses.theta``."""
-    th = poses.theta[body.id]
     rx, ry = p[0] - body.pivot[0], p[1] - body.pivot[1]
-    c, s = cos_sin(th)
+    c, s = poses.theta.cos_sin(body.id)
     return rx * c - ry * s - rx, rx * s + ry * c - ry
 
 

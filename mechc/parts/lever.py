@@ -7,8 +7,8 @@ import numpy as np
 import pymunk
 
 from mechc.ir.mechanism import Body, Joint, Point
-from mechc.parts.base import BodyKind, Coords, SceneBuilder, Shape
-from mechc.parts.poses import Poses, cos_sin
+from mechc.parts.base import BodyKind, Coords, SceneBuilder, Shape, placed_key, rotate
+from mechc.parts.poses import Poses
 
 
 class Lever(BodyKind):
@@ -17,21 +17,19 @@ class Lever(BodyKind):
 
     @classmethod
     def position(cls, body: Body, poses: Poses, p) -> Coords:
-        """pivot + R(θ)·arm: fewer array passes than point + displacement."""
-        c, s = cos_sin(poses.theta[body.id])
-        rx, ry = p[0] - body.pivot[0], p[1] - body.pivot[1]
-        x, y = rx * c, rx * s
-        x -= ry * s
-        y += ry * c
-        x += body.pivot[0]
-        y += body.pivot[1]
-        return x, y
+        """The point where this solve's closed form placed it (no trig), else
+        pivot + R(θ)·arm, skipping the terms of an arm component that is exactly 0."""
+        turn = poses.theta.entry(body.id)
+        hit = poses.placed.get(placed_key(body, p))
+        if hit is not None and hit[2] is turn:
+            return hit[0], hit[1]
+        c, s = turn.cos_sin() if turn is not None else poses.theta.cos_sin(body.id)
+        return rotate(p[0] - body.pivot[0], p[1] - body.pivot[1], c, s, body.pivot)
 
     @classmethod
     def arm(cls, body: Body, poses: Poses, p) -> Coords:
-        th = poses.theta[body.id]
         r = (p[0] - body.pivot[0], p[1] - body.pivot[1])
-        c, s = np.cos(th), np.sin(th)
+        c, s = poses.theta.cos_sin(body.id)
         return r[0] * c - r[1] * s, r[0] * s + r[1] * c
 
     @classmethod

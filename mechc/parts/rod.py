@@ -7,6 +7,8 @@ circles; pymunk's PinJoint."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pymunk
 
@@ -17,6 +19,7 @@ from mechc.parts.base import (
     SceneBuilder,
     Shape,
     cross,
+    is_number,
     lever_arm,
     line_cotan,
     line_tan,
@@ -25,6 +28,7 @@ from mechc.parts.base import (
     position,
     ratio_tan,
     side_of,
+    sized,
 )
 from mechc.parts.poses import Poses
 
@@ -66,8 +70,10 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
 
     Worked in units of the centre distance d (D = rod end - pivot): the pin sits at
     A·D ± H·D⊥ from the pivot with A = 1/2 + (r² - L²)/(2d²) and H² = r²/d² - A², so one
-    division, one square root and one arctan2 place it; the transmission angle comes from the
-    same numbers (law of cosines: arm·rod = (d² - r² - L²)/2, |arm×rod| = H·d²) by arctan2,
+    division and one square root place it (the lever keeps the arm as its pose: the arctan2 of
+    its angle is taken only if the angle is read, :class:`mechc.parts.poses.Turn`, and the pin
+    is not read back through it); the transmission angle comes from the
+    same numbers (arm·rod = r² - A·d², |arm×rod| = H·d²) as a tangent,
     which unlike arccos of a cosine stays accurate at the toggle (H -> 0). It is the same
     circle meeting as :func:`mechc.geometry.circles.circle_meeting`, kept in these units
     because it is the hot path of every kinematic proof (the transmission angle shares its
@@ -78,20 +84,25 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     L2 = j.length * j.length
     cx, cy = position(other, poses, theirs)
     dx, dy = cx - P[0], cy - P[1]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / (dx * dx + dy * dy)  # d = 0 or NaN: A, H2 NaN below, the state is bad
-        A = 0.5 * (r2 - L2) * inv
+    with np.errstate(divide="ignore", invalid="ignore"):  # temporaries reused in place
+        inv = dx * dx
+        inv += dy * dy
+        np.divide(1.0, inv, out=inv)  # d = 0 or NaN: A, H2 NaN below, the state is bad
+        A = inv * (0.5 * (r2 - L2))
         A += 0.5
-        H2 = r2 * inv - A * A
-        ok = H2 >= 0
-        H = np.sqrt(H2)  # unsolved states (past the toggle): NaN pin, NaN angle
+        u = inv * r2  # r²/d²
+        H = A * A
+        np.subtract(u, H, out=H)  # H² = r²/d² - A²
+        ok = H >= 0
+        np.sqrt(H, out=H)  # unsolved states (past the toggle): NaN pin, NaN angle
         # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the
         # toggle (fmax takes 0 over H's NaN there); kept as its tangent |arm×rod| / |arm·rod|
-        # (the check converts the smallest only)
-        gamma = ratio_tan(np.fmax(H, 0.0), np.abs(0.5 - 0.5 * (r2 + L2) * inv))
+        # with arm·rod = r² - A·d² (the check converts the smallest only)
+        u -= A
+        gamma = ratio_tan(np.fmax(H, 0.0), np.abs(u, out=u))
     side = side_of(cross((theirs[0] - P[0], theirs[1] - P[1]), (mine[0] - P[0], mine[1] - P[1])))
     rx, ry = A * dx, A * dy
-    if np.ndim(side):  # dimensions as arrays (a tolerance run): the branch per sample
+    if not isinstance(side, float):  # dimensions as arrays (a tolerance run): per sample
         rx -= side * H * dy
         ry += side * H * dx
     elif side > 0:
@@ -100,25 +111,21 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     else:
         rx += H * dy
         ry -= H * dx
-    phi0 = np.arctan2(mine[1] - P[1], mine[0] - P[0])
-    theta = np.arctan2(ry, rx)
-    theta -= phi0  # in [-pi - phi0, pi - phi0]: wrap the one side that can leave [-pi, pi)
-    if np.ndim(phi0):
-        theta = (theta + np.pi) % (2 * np.pi) - np.pi
-    elif phi0 > 0:
-        np.add(theta, 2 * np.pi, out=theta, where=theta < -np.pi)
-    else:
-        np.subtract(theta, 2 * np.pi, out=theta, where=theta >= np.pi)
-    poses.theta[lever.id] = theta if theta.shape == (size,) else np.broadcast_to(
-        theta, (size,)).copy()
+    if rx.shape != (size,):
+        rx, ry = (np.broadcast_to(v, (size,)).copy() for v in (rx, ry))
+    # the lever's pose is the arm it turned to: its angle (an arctan2) is taken when read
+    mx, my = mine[0] - P[0], mine[1] - P[1]
+    phi0 = math.atan2(my, mx) if is_number(mx) and is_number(my) else np.arctan2(my, mx)
+    poses.theta.set_arm(lever.id, rx, ry, mx, my, phi0)
     other_bad = poses.bad.get(other.id if other else GROUND)
-    bad = ~np.broadcast_to(ok, (size,))
-    poses.mark(lever.id, bad if other_bad is None else bad | other_bad)
-    rx += P[0]
-    ry += P[1]
-    poses.placed[placed_key(lever, mine)] = (rx, ry)
+    bad = ~sized(ok, size)
+    if other_bad is not None:
+        bad |= other_bad
+    poses.mark(lever.id, bad, own=True)
+    poses.placed[placed_key(lever, mine)] = (rx + P[0], ry + P[1],
+                                             poses.theta.entry(lever.id))
     if other is not None:
-        poses.placed[placed_key(other, theirs)] = (cx, cy)
+        poses.placed[placed_key(other, theirs)] = (cx, cy, poses.theta.entry(other.id))
     if gamma.shape != (size,):
         gamma = np.broadcast_to(gamma, (size,)).copy()
     poses.transmission.set_tan(j.id, gamma)  # read-only from here on: one array serves both
@@ -136,15 +143,16 @@ class Rod(JointKind):
         """|distance - length| > 1e-6, squared: no square root."""
         ax_, ay_ = placed_position(a, poses, j.pa)
         bx_, by_ = placed_position(b, poses, j.pb)
-        ex, ey = bx_ - ax_, by_ - ay_
-        g2 = ex * ex
-        g2 += ey * ey
+        g2, ey = bx_ - ax_, by_ - ay_  # the differences are temporaries: squared in place
+        g2 *= g2
+        ey *= ey
+        g2 += ey
         viol = g2 > (j.length + 1e-6) ** 2
-        if np.ndim(j.length):  # a length per sample (a tolerance run)
+        if not is_number(j.length):  # a length per sample (a tolerance run)
             viol |= (j.length > 1e-6) & (g2 < (j.length - 1e-6) ** 2)
         elif j.length > 1e-6:
             viol |= g2 < (j.length - 1e-6) ** 2
-        return np.broadcast_to(viol, (size,))
+        return sized(viol, size)
 
     @classmethod
     def shapes(cls, j: Joint, at: Placer) -> list[Shape]:

@@ -62,8 +62,11 @@ def solve(part: Part, fixed: dict[str, np.ndarray], size: int,
     for bid, u in fixed.items():
         b = bodies[bid]
         kind = body_kind(b.kind)
-        getattr(poses, kind.coordinate)[bid] = np.broadcast_to(
-            np.asarray(u, dtype=float), (size,)).copy()
+        if isinstance(u, np.ndarray) and u.dtype == np.float64 and u.shape == (size,):
+            u = u.copy()
+        else:
+            u = np.broadcast_to(np.asarray(u, dtype=float), (size,)).copy()
+        getattr(poses, kind.coordinate)[bid] = u
         poses.bad[bid] = np.zeros(size, dtype=bool)
         if not kind.input_terminal:
             raise KinematicsError(f"{bid}: a free {b.kind} cannot be an input terminal")
