@@ -118,7 +118,11 @@ class ProofReport(Mapping):
 
 def sampled_text(cases: int, coverage: dict) -> str:
     """'1024 cases', or for a proof that is not exhaustive 'sampled 512 of 32768 cases' (and of
-    the single-input changes, where the engine says how many there are)."""
+    the single-input changes, where the engine says how many there are); a SAT proof covers
+    every vector without enumerating them, and says so."""
+    if coverage.get("method") == "sat":
+        n = max(int(cases).bit_length() - 1, 0)
+        return f"all 2^{n} vectors by a SAT miter ({coverage.get('solver', 'SAT')})"
     if coverage.get("exhaustive") is not False:
         return f"{cases} cases"
     total = coverage.get("cases_total")
