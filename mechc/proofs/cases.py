@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mechc.errors import UsageError
 from mechc.ir.netlist import Netlist
 
 
@@ -82,6 +83,18 @@ def _toggles(nl: Netlist, names: list[str], lo: np.ndarray, k: np.ndarray,
     out = [nl.cells[c].outputs[0] for c in cells]
     return np.stack([a[net] != b[net] for net in out], axis=1) if out \
         else np.zeros((len(k), 0), dtype=bool)
+
+
+def try_directed(nl: Netlist, names: list[str], seed: int) -> Directed | None:
+    """:func:`directed_changes`, or None where the netlist cannot be evaluated as logic (a
+    stateful cell, or a logic type whose cell file is not loaded): the proofs that call it
+    then run their random sample alone, as they did before."""
+    if nl.state_nets():
+        return None
+    try:
+        return directed_changes(nl, names, seed)
+    except (UsageError, TypeError):
+        return None
 
 
 def directed_changes(nl: Netlist, names: list[str], seed: int) -> Directed:

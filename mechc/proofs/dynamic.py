@@ -33,7 +33,7 @@ from mechc.logic.cubes import DC
 from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, MoveResult, Scene
 from mechc.proofs.accuracy import HALVING_CASES, ErrorModel, choose, confirm, load_model
-from mechc.proofs.cases import directed_changes, gray_tour, random_walk
+from mechc.proofs.cases import gray_tour, random_walk, try_directed
 from mechc.proofs.kinematic import sweep
 from mechc.proofs.parallel import run_cases
 from mechc.proofs.prune import FREEZE, blocker, run_case
@@ -64,9 +64,9 @@ def plan_changes(design: Design, names: list[str], extra: int, seed: int,
     n = len(names)
     walk = plan(n, extra, seed)
     pairs = list(zip([0, *walk], walk))
-    if n <= 10 or not independent or design.netlist.state_nets():
+    dr = try_directed(design.netlist, names, seed) if n > 10 and independent else None
+    if dr is None:
         return pairs, None
-    dr = directed_changes(design.netlist, names, seed)
     first = []
     for j in range(len(dr.k)):
         lo = sum(int(dr.lo[i, j]) << (n - 1 - i) for i in range(n))

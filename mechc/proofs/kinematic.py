@@ -24,7 +24,7 @@ from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError, Poses
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.physics.measures import CheckStats
-from mechc.proofs.cases import bits, directed_changes, single_changes
+from mechc.proofs.cases import bits, single_changes, try_directed
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings
@@ -75,9 +75,8 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
         edge_bits = rng.random((n, sample)) < 0.5
         edge_bits[e_k, np.arange(len(e_k))] = False
         exhaustive = False
-        if directed and not design.netlist.state_nets():
-            # first the changes that switch every cell, then the random ones
-            dr = directed_changes(design.netlist, names, seed)
+        dr = try_directed(design.netlist, names, seed) if directed else None
+        if dr is not None:  # first the changes that switch every cell, then the random ones
             edge_bits = np.concatenate([dr.lo, edge_bits], axis=1)
             e_k = np.concatenate([dr.k, e_k])
             rest_bits = np.concatenate([dr.lo, rest_bits], axis=1)
