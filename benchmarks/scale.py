@@ -8,10 +8,11 @@ BCD-to-7-segment decoder, magnitude comparators of 8-32 bits, array multipliers 
 and, with ``--mcnc DIR`` (default: an ``mcnc`` directory beside the repository, skipped when
 absent; the MCNC PLAs are not shipped with mechc), every PLA there of at most
 ``--max-two-level-inputs`` inputs. Each circuit is compiled by ``mechc compile`` in a process of
-its own, killed after ``--time-limit`` seconds: two-level from its ``.bool`` (or the PLA), and
-multi-level from its structural Verilog with ``--levels multi`` where ``mechc compile --help``
-offers ``--levels`` (else that column stays empty and the run says why). A two-level compile
-is not attempted above ``--max-two-level-inputs`` inputs (an n-bit adder's two-level form has
+its own, stopped after ``--time-limit`` CPU seconds (or five times that in wall time):
+two-level from its ``.bool`` (or the PLA), and multi-level from its structural Verilog with
+``--levels multi`` where ``mechc compile --help`` offers ``--levels`` (else that column stays
+empty and the run says why). A two-level compile is not attempted above
+``--max-two-level-inputs`` inputs (an n-bit adder's two-level form has
 about 2**n products); the table says so instead of hanging.
 
 Compile time is the CPU time (user + system) of the ``mechc compile`` process, less the CPU time
@@ -74,13 +75,25 @@ class Row:
     runs: dict[str, Run] = field(default_factory=dict)
 
 
-def mechc(*args: str, timeout: float | None = None) -> subprocess.CompletedProcess:
-    """``mechc ARGS`` in a fresh interpreter on this checkout's code; ``.cpu`` on the result is
-    the CPU seconds it took."""
+#: The wall-clock allowance of a compile, as a multiple of its CPU limit (a loaded machine).
+WALL_FACTOR = 5
+
+
+def mechc(*args: str, cpu_limit: float | None = None) -> subprocess.CompletedProcess:
+    """``mechc ARGS`` in a fresh interpreter on this checkout's code, stopped by the kernel
+    after ``cpu_limit`` CPU seconds (so other load on the machine does not cut it short);
+    ``.cpu`` on the result is the CPU seconds it took."""
     env = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
+
+    def limit() -> None:
+        if cpu_limit is not None:
+            secs = int(math.ceil(cpu_limit))
+            resource.setrlimit(resource.RLIMIT_CPU, (secs, secs + 5))
+
     p = subprocess.run([sys.executable, "-m", "mechc", *args], capture_output=True, text=True,
-                       timeout=timeout, env=env)
+                       timeout=cpu_limit * WALL_FACTOR if cpu_limit else None, env=env,
+                       preexec_fn=limit)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     p.cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return p
@@ -98,9 +111,12 @@ def has_levels() -> bool:
 def compile_once(src: Path, out: Path, extra: list[str], limit: float) -> Run:
     """Compile ``src``; the summary line gives cells, parts and seconds."""
     try:
-        p = mechc("compile", str(src), "-o", str(out), "--quiet", *extra, timeout=limit)
+        p = mechc("compile", str(src), "-o", str(out), "--quiet", *extra,
+                  cpu_limit=limit + STARTUP[0])
     except subprocess.TimeoutExpired:
-        return Run(note=f"over {limit:g} s")
+        return Run(note=f"over {limit * WALL_FACTOR:g} s wall")
+    if p.returncode < 0:  # SIGXCPU (or SIGKILL past the hard limit): the CPU limit ran out
+        return Run(note=f"over {limit:g} CPU s")
     m = next((SUMMARY.search(line) for line in p.stdout.splitlines() if SUMMARY.search(line)),
              None)
     if m is None:
@@ -198,7 +214,8 @@ def chart(rows: list[Row], methods: list[str], fits: dict, path: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--time-limit", type=float, default=120.0, metavar="S",
-                    help="seconds one compile may take (default: %(default)s)")
+                    help="CPU seconds one compile may take, start-up aside (default: "
+                    "%(default)s; and 5x that in wall time)")
     ap.add_argument("--max-two-level-inputs", type=int, default=16, metavar="N",
                     help="two-level compiles are not attempted above N inputs (default: "
                     "%(default)s)")
