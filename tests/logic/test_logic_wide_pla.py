@@ -230,8 +230,13 @@ def test_sampled_proof_catches_a_netlist_that_lost_a_literal(cli, tmp_path):
     src = tmp_path / "w.pla"
     src.write_text(text)
     out = tmp_path / "w.json"
-    assert cli("compile", src, "-o", out, *COMPILE)[0] == 0
+    # --no-prove: this design has a static-1 hazard (f0 dips to mid-stroke when x8 moves at
+    # one vector) that the kinematic proof's changes chosen to switch every cell find and
+    # compile then refuses; the subject here is the logic level
+    assert cli("compile", src, "-o", out, *COMPILE, "--no-prove")[0] == 0
     assert cli("simulate", out, "--level", "logic")[0] == 0
+    code, stdout, _ = cli("simulate", out, "--level", "kinematic")
+    assert code == 1 and "dwell: x8 moving output f0 (expected 1)" in stdout
     design = json.loads(out.read_text())
     cell = next(c for c in design["cells"] if c["type"] == "AND" and len(c["inputs"]) >= 3)
     cell["inputs"] = cell["inputs"][1:]
