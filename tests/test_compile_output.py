@@ -8,6 +8,7 @@ import copy
 import gzip
 import io
 import json
+import re
 import time
 
 import jsonschema
@@ -213,10 +214,18 @@ def test_a_sampled_proof_says_sampled_n_of_m(cli, tmp_path):
     spec.write_text(f"inputs {' '.join(names)}\noutputs z\nz = a0 & a1 | a10\n")
     code, stdout, err = cli("compile", spec, "-o", tmp_path / "w.json")
     assert code == 0, err
-    assert ("kinematic proof: proved, sampled 512 of 2048 cases, sampled 512 of 11264 "
-            "single-input changes (not exhaustive)") in stdout
+    # 512 random states and changes, led by the changes that switch every cell (and their
+    # start states)
+    design = json.loads((tmp_path / "w.json").read_text())
+    cells = len(design["cells"])
+    m = re.search(r"kinematic proof: proved, sampled (\d+) of 2048 cases, proven on (\d+) of "
+                  r"11264 single-input changes, sampled, (\d+) of them chosen to switch every "
+                  rf"cell: {cells} of {cells} cells switched \(not exhaustive\)", stdout)
+    assert m, stdout
+    directed = int(m.group(3))
+    assert 1 <= directed <= cells and int(m.group(1)) == int(m.group(2)) == 512 + directed
     code, stdout, _ = cli("simulate", tmp_path / "w.json", "--level", "kinematic")
-    assert "sampled 512 of 2048 cases" in stdout
+    assert f"sampled {512 + directed} of 2048 cases" in stdout
 
 
 def test_merged_flow_table_rows_are_named(cli, tmp_path):

@@ -17,6 +17,7 @@ from mechc.physics.scene import DynSettings
 from mechc.proofs import LEVELS, ProofReport, ProofSettings, prove, spec_kind
 from mechc.proofs import trace as pose_trace
 from mechc.proofs.parallel import available_cores
+from mechc.proofs.settings import LOGIC_METHODS
 from mechc.ui import Progress, finite_float
 
 
@@ -27,7 +28,8 @@ def register(sub) -> None:
 Prove a design: SPEC_OR_JSON is a compiled design (.json) or a spec, compiled in memory first.
 
 levels:
-  logic      the netlist's cells evaluated as Boolean functions on every input vector
+  logic      the netlist's cells evaluated as Boolean functions on every input vector; a
+             design too wide to enumerate is proved by a SAT miter instead (--logic-method)
   kinematic  the mechanism's closed forms (from its geometry, not its logic types) on every
              input vector at rest and sampled along every single-input change: outputs within
              --tolerance of their positions, outputs that must not change dwell; design checks
@@ -49,6 +51,10 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
                    help="dynamic: seeded random single-input changes after the Gray tour "
                    "(default: %(default)s)")
     s.add_argument("--seed", type=int, default=0, help="seed for the random cases")
+    s.add_argument("--logic-method", choices=list(LOGIC_METHODS), default="auto",
+                   help="logic: every vector evaluated (exhaustive), proved by a SAT miter "
+                   "(sat), or a seeded sample (sampled, not a proof); auto: exhaustive while "
+                   "cheap, else sat (default: %(default)s)")
     s.add_argument("--dt", type=finite_float, default=None, metavar="S",
                    help="dynamic: time step in seconds (default 2.5e-4)")
     s.add_argument("--iterations", type=int, default=None,
@@ -103,6 +109,8 @@ def _check_options(args: argparse.Namespace) -> None:
             raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError("--jobs must be at least 1")
+    if args.logic_method != "auto" and args.level != "logic":
+        raise UsageError("--logic-method chooses how the logic level checks (--level logic)")
     if args.scheduler is not None and args.level != "dynamic":
         raise UsageError("--scheduler runs the cases of a dynamic proof (--level dynamic)")
     if args.report:  # before a proof that may take minutes, not after it
@@ -158,6 +166,7 @@ def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: 
     """The proof at ``args.level`` of ``design`` against ``spec`` (a ProofReport), with a
     progress bar while a kinematic or dynamic proof runs (shown after 1.5 s)."""
     settings = ProofSettings(tolerance=args.tolerance, seed=args.seed, cases=args.cases,
+                             logic_method=args.logic_method,
                              prune=args.prune, accuracy=args.accuracy, dt=args.dt,
                              iterations=args.iterations, move_time=args.move_time,
                              trace=trace, jobs=args.jobs or available_cores(),

@@ -33,7 +33,7 @@ from mechc.logic.cubes import DC
 from mechc.physics.measures import CheckStats
 from mechc.physics.scene import DynSettings, MoveResult, Scene
 from mechc.proofs.accuracy import HALVING_CASES, ErrorModel, choose, confirm, load_model
-from mechc.proofs.cases import gray_tour, random_walk
+from mechc.proofs.cases import gray_tour, random_walk, try_directed
 from mechc.proofs.kinematic import sweep
 from mechc.proofs.parallel import run_cases
 from mechc.proofs.prune import FREEZE, blocker, run_case
@@ -53,6 +53,25 @@ def plan(n: int, extra: int, seed: int) -> list[int]:
         return random_walk(n, 0, max(extra, 64), seed)
     walk = random_walk(n, tour[-1] if tour else 0, extra, seed)
     return tour + walk
+
+
+def plan_changes(design: Design, names: list[str], extra: int, seed: int,
+                 independent: bool) -> tuple[list[tuple[int, int]], dict | None]:
+    """The changes to run as (from vector, to vector) pairs, and what chose them. Up to 10
+    inputs (or when each change cannot be a case of its own): :func:`plan`'s walk. Beyond,
+    for a design whose changes are independent cases: the changes that switch every cell
+    (:func:`mechc.proofs.cases.directed_changes`), then :func:`plan`'s random walk."""
+    n = len(names)
+    walk = plan(n, extra, seed)
+    pairs = list(zip([0, *walk], walk))
+    dr = try_directed(design.netlist, names, seed) if n > 10 and independent else None
+    if dr is None:
+        return pairs, None
+    first = []
+    for j in range(len(dr.k)):
+        lo = sum(int(dr.lo[i, j]) << (n - 1 - i) for i in range(n))
+        first.append((lo, lo | 1 << (n - 1 - int(dr.k[j]))))
+    return first + pairs, dr.coverage()
 
 
 @engine("dynamic", "combinational")
@@ -186,20 +205,25 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     sizes: list[tuple[int, int, int]] = []  # pruned scenes: (cells, dynamic bodies, constraints)
     escalated = 0
     max_watch = 0.0
-    vectors = plan(n, extra, seed)
-    if max_cases is not None:
-        vectors = vectors[:max_cases]
-    cols = np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in [0, *vectors]],
-                    dtype=bool).T
-    wants = spec.values_at(cols)  # spec value before (column i) and after (i + 1) each change
-    job = ChangeJob(design, names, types, st, cells, prune, freeze, trace)
-    changes = [Change(cur, vec, {o: int(wants[o][i]) for o in spec.outputs},
-                      {o: int(wants[o][i + 1]) for o in spec.outputs})
-               for i, (cur, vec) in enumerate(zip([0, *vectors], vectors))]
     # a circuit whose rest depends on its past (a stateful cell) runs the whole tour on one
     # scene; otherwise every change is a case of its own, on a scene built at its start
-    segments = ([changes] if blocker(design.netlist, lib) is not None
-                else [[c] for c in changes])
+    one_scene = blocker(design.netlist, lib) is not None
+    pairs, chosen = plan_changes(design, names, extra, seed, independent=not one_scene)
+    if max_cases is not None:
+        pairs = pairs[:max_cases]
+    vectors = [vec for _, vec in pairs]
+
+    def columns(vs: list[int]) -> np.ndarray:
+        return np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in vs],
+                        dtype=bool).reshape(len(vs), n).T
+
+    before = spec.values_at(columns([cur for cur, _ in pairs]))
+    after = spec.values_at(columns(vectors))
+    job = ChangeJob(design, names, types, st, cells, prune, freeze, trace)
+    changes = [Change(cur, vec, {o: int(before[o][i]) for o in spec.outputs},
+                      {o: int(after[o][i]) for o in spec.outputs})
+               for i, (cur, vec) in enumerate(pairs)]
+    segments = [changes] if one_scene else [[c] for c in changes]
     if trace is not None:  # the recorder lives in this process: the changes run here
         jobs, scheduler = 1, None
     runs = [run for seg in run_cases(run_segment, job, segments, lib, jobs, scheduler, progress,
@@ -211,13 +235,13 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     worst_joint = ""
     max_dev = 0.0
     steps = 0
-    for i, (vec, run) in enumerate(zip(vectors, runs)):
+    for i, ((cur, vec), run) in enumerate(zip(pairs, runs)):
         r = run.result
         if prune:
             sizes.append(run.size)
             escalated += run.escalated
             max_watch = max(max_watch, run.watch_deviation)
-        k = (n - 1) - ((vectors[i - 1] if i else 0) ^ vec).bit_length() + 1
+        k = (n - 1) - (cur ^ vec).bit_length() + 1
         name = names[k]
         target = (vec >> (n - 1 - k)) & 1
         steps += r.steps
@@ -249,8 +273,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         if lag is not None and lag > tolerance * mech.ctx.stroke:
             fail("stall", message=f"input {name} ended {lag:.3g} mm short of its target")
         for o in spec.outputs:
-            want = int(wants[o][i + 1])
-            before = int(wants[o][i])
+            want = int(after[o][i])
+            was = int(before[o][i])
             got = r.final.get(o)
             if got is None:
                 continue
@@ -261,7 +285,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                 max_dev = max(max_dev, dev)
                 if dev > tolerance or not math.isfinite(dev):
                     fail("rest", output=o, expected=want, position=round(got, 6))
-            if want != DC and want == before and o in r.outputs:
+            if want != DC and want == was and o in r.outputs:
                 glitch = float(np.max(np.abs(r.outputs[o] - want)))
                 max_dev = max(max_dev, glitch)
                 if glitch > tolerance:
@@ -280,7 +304,10 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     return ProofReport(
         level="dynamic", kind="combinational", passed=total_fail == 0, cases=len(vectors),
         coverage={"tour": min(len(vectors), (1 << n) - 1) if n <= 10 else 0,
-                  "random_changes": extra, "seed": seed, "tolerance_fraction": tolerance},
+                  "random_changes": extra, "seed": seed, "tolerance_fraction": tolerance,
+                  # beyond 10 inputs a sample: of how many single-input changes, chosen how
+                  **({"exhaustive": False, "transitions": len(pairs),
+                      "transitions_total": n << (n - 1), **(chosen or {})} if n > 10 else {})},
         failure_count=total_fail, failure_kinds={k: v for k, v in counts.items() if v},
         failures=failures,
         figures={

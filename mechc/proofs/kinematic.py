@@ -24,7 +24,7 @@ from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError, Poses
 from mechc.physics.evaluate import evaluate, output_signals
 from mechc.physics.measures import CheckStats
-from mechc.proofs.cases import bits, single_changes
+from mechc.proofs.cases import bits, single_changes, try_directed
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings
@@ -38,7 +38,7 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
           inputs_order: list[str] | None = None, stats: PoseSink | None = None,
           budget: int = 20_000_000, sample: int = 512, max_states: int | None = None,
           on_poses: Callable[[Poses, int], None] | None = None,
-          progress: OnProgress | None = None):
+          progress: OnProgress | None = None, directed: bool = False):
     """Evaluate rest states and single-input changes (``samples`` points along the moving
     input), in chunks so memory stays bounded; returns output signals only, and feeds the
     design-check statistics ``stats`` as it goes.
@@ -47,8 +47,11 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
     ``sample`` vectors and as many changes (as boolean matrices, so any number of inputs
     works). ``on_poses`` receives the poses of every chunk of states in the order evaluated
     (the rest states, then each change's samples): a trace. ``progress`` is told the states
-    evaluated so far and their total after every chunk."""
+    evaluated so far and their total after every chunk. Beyond 10 inputs (``directed``, a
+    combinational netlist) the sample is led by changes chosen to switch every cell
+    (:func:`mechc.proofs.cases.directed_changes`) and by their start states."""
     mech = design.mechanism
+    chosen: dict | None = None
     names = inputs_order or list(design.netlist.inputs)
     n = len(names)
     full = (1 << n) + n * (1 << max(n - 1, 0)) * samples if n <= EXHAUSTIVE_MAX_INPUTS else 0
@@ -72,6 +75,12 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
         edge_bits = rng.random((n, sample)) < 0.5
         edge_bits[e_k, np.arange(len(e_k))] = False
         exhaustive = False
+        dr = try_directed(design.netlist, names, seed) if directed else None
+        if dr is not None:  # first the changes that switch every cell, then the random ones
+            edge_bits = np.concatenate([dr.lo, edge_bits], axis=1)
+            e_k = np.concatenate([dr.k, e_k])
+            rest_bits = np.concatenate([dr.lo, rest_bits], axis=1)
+            chosen = {**dr.coverage(), "random_changes": sample, "random_states": sample}
     types = {c.id: c.cell for c in design.netlist.cells.values()}
     n_bodies = max(1, len(mech.body_index()))
     chunk = max(64, budget // (3 * n_bodies))
@@ -107,7 +116,7 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
             path.setdefault(o, []).append(v)
     return dict(names=names, rest_bits=rest_bits, rest=rest, edge_bits=edge_bits, e_k=e_k,
                 path={o: np.concatenate(v) for o, v in path.items()}, samples=samples,
-                exhaustive=exhaustive)
+                exhaustive=exhaustive, directed=chosen)
 
 
 @engine("kinematic", "combinational")
@@ -129,7 +138,7 @@ def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float =
     mech = design.mechanism
     stats = CheckStats(mech)
     try:
-        sw = sweep(design, lib, samples, seed, names, stats,
+        sw = sweep(design, lib, samples, seed, names, stats, directed=True,
                    on_poses=trace.take if trace is not None else None, progress=progress)
     except KinematicsError as e:
         raise UsageError(f"the geometry is not a determinate mechanism: {e}") from None
@@ -191,7 +200,8 @@ def prove_kinematic(design: Design, spec: Spec, lib: Library, tolerance: float =
                   "exhaustive": sw["exhaustive"], "tolerance_fraction": tolerance,
                   # what an exhaustive proof would visit: a sampled one is "N of M"
                   "cases_total": 1 << len(names),
-                  "transitions_total": len(names) << max(len(names) - 1, 0)},
+                  "transitions_total": len(names) << max(len(names) - 1, 0),
+                  **(sw["directed"] or {})},
         failure_count=fail_count, failures=failures,
         figures={
             "max_deviation_fraction": round(max_dev, 9),

@@ -1,10 +1,13 @@
-"""Logic level: evaluate the netlist's cells on input vectors and compare with the spec.
+"""Logic level: the netlist's cells against the spec on every input vector.
 
-Up to ``MAX_TABLE_INPUTS`` inputs every vector is checked. Wider specs (PLAs of up to 117
-inputs) cannot be enumerated, so the check is a sample and says so (``exhaustive: false``):
-every point of each spec cube with few free inputs, random points inside the larger cubes, the
-points just outside each cube (one literal flipped) and uniformly random vectors, all seeded so
-a report can be reproduced.
+Three methods (:func:`choose_method` picks one unless told): ``exhaustive`` evaluates every
+vector (small designs: up to ``EXHAUSTIVE_MAX_INPUTS`` inputs always, up to
+``MAX_TABLE_INPUTS`` while cells x vectors stays within ``EXHAUSTIVE_WORK``); ``sat`` proves
+the same over all 2**n vectors with a SAT miter (:mod:`mechc.proofs.sat_equiv`), for designs
+too wide to enumerate; ``sampled`` is the check of old for wide specs, kept as the fallback
+when a cell has no CNF form and on request: every point of each spec cube with few free
+inputs, random points inside the larger cubes, the points just outside each cube (one literal
+flipped) and uniformly random vectors, all seeded, and it says so (``exhaustive: false``).
 """
 
 from __future__ import annotations
@@ -15,15 +18,30 @@ import numpy as np
 
 from mechc.cells.library import Library
 from mechc.errors import UsageError
+from mechc.ir import expr as ex
 from mechc.ir.design import Design
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, input_matrix
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import LOGIC_FIGURES, ProofReport
-from mechc.proofs.settings import ProofSettings
+from mechc.proofs.sat_equiv import (
+    EXAMPLES_PER_OUTPUT,
+    NotEncodable,
+    check_equivalence,
+    confirmed_failures,
+)
+from mechc.proofs.settings import LOGIC_METHODS, ProofSettings
 
 MAX_LISTED_FAILURES = 50
+#: Up to this many inputs every vector is evaluated, whatever the design's size.
+EXHAUSTIVE_MAX_INPUTS = 14
+#: Beyond EXHAUSTIVE_MAX_INPUTS (and up to MAX_TABLE_INPUTS), exhaustive while (cells + spec
+#: nodes and cubes) x vectors stays within this (about a second of numpy, a few hundred MB of
+#: nets), else SAT. Measured (docs/performance.md): t481 (16 inputs, 1300 cells) 0.19 s
+#: exhaustive against 2.6 s by SAT; a 10-bit adder (20 inputs, 47 cells, its spec as
+#: expressions) 4.2 s exhaustive against 0.05 s by SAT.
+EXHAUSTIVE_WORK = 1 << 28
 #: Wide specs: cubes with at most this many free inputs have every point checked.
 CORNER_FREE_MAX = 8
 #: Wide specs: cap on vectors taken from spec cubes; past it each cube gives a few points.
@@ -41,14 +59,74 @@ NEIGHBOUR_CORNERS = 4
 def logic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
                  progress: OnProgress | None) -> ProofReport:
     # the sampled check of a wide spec keeps seed 0, as ``mechc simulate`` always has
-    return prove_logic(design.netlist, spec)
+    return prove_logic(design.netlist, spec, method=settings.logic_method)
 
 
-def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> ProofReport:
+def choose_method(nl: Netlist, spec: Spec) -> str:
+    """``exhaustive`` where enumerating every vector is cheap, else ``sat``."""
+    n = spec.n
+    if n <= EXHAUSTIVE_MAX_INPUTS:
+        return "exhaustive"
+    if n <= MAX_TABLE_INPUTS and (len(nl.cells) + spec_size(spec) + n) << n <= EXHAUSTIVE_WORK:
+        return "exhaustive"
+    return "sat"
+
+
+def spec_size(spec: Spec) -> int:
+    """Expression nodes and cubes of the spec: what building its tables costs per vector."""
+    def nodes(e: ex.Expr) -> int:
+        return 1 + sum(nodes(a) for a in getattr(e, "args", ())) + \
+            (nodes(e.arg) if isinstance(e, ex.Not) else 0)
+
+    return sum((nodes(f.expr) if f.expr is not None else len(f.on)) + len(f.dc) + len(f.off)
+               for f in spec.functions.values())
+
+
+def prove_logic(nl: Netlist, spec: Spec, seed: int = 0, method: str = "auto") -> ProofReport:
+    """The logic proof by ``method`` (one of ``LOGIC_METHODS``; ``auto``: :func:`choose_method`).
+    A SAT proof of a netlist with a cell that has no CNF form falls back to sampling (wide
+    specs) or enumeration, and the report says why (``coverage.sat_refused``)."""
     t0 = time.perf_counter()
     check_interface(nl, spec)
-    if spec.n > MAX_TABLE_INPUTS:
-        return _check_sampled(nl, spec, t0, seed)
+    if method not in LOGIC_METHODS:
+        raise UsageError(f"no logic method {method!r} (methods: {', '.join(LOGIC_METHODS)})")
+    if method == "auto":
+        method = choose_method(nl, spec)
+    if method == "exhaustive" and spec.n > MAX_TABLE_INPUTS:
+        raise UsageError(f"{spec.n} inputs cannot be enumerated (at most {MAX_TABLE_INPUTS}): "
+                         "prove by sat or sampled")
+    refused = None
+    if method == "sat":
+        try:
+            return _check_sat(nl, spec, t0)
+        except NotEncodable as e:
+            refused = str(e)
+            method = "exhaustive" if spec.n <= MAX_TABLE_INPUTS else "sampled"
+    if method == "sampled":
+        rep = _check_sampled(nl, spec, t0, seed)
+    else:
+        rep = _check_exhaustive(nl, spec, t0)
+    if refused:
+        rep.coverage["sat_refused"] = refused
+    return rep
+
+
+def _check_sat(nl: Netlist, spec: Spec, t0: float) -> ProofReport:
+    """Every vector at once: a miter of netlist and spec, and its counterexamples."""
+    eq = check_equivalence(nl, spec)
+    failures = list(confirmed_failures(nl, spec, eq))
+    return ProofReport(
+        level="logic", kind="combinational", passed=not failures, cases=1 << spec.n,
+        coverage={"method": "sat", "exhaustive": False, "complete": True,
+                  "solver": eq.solver, "variables": eq.variables, "clauses": eq.clauses,
+                  # failure_count counts the counterexamples found (up to this many per
+                  # output), not every failing vector
+                  "counterexamples_per_output": EXAMPLES_PER_OUTPUT},
+        failure_count=len(failures), failures=failures[:MAX_LISTED_FAILURES],
+        figures=dict(LOGIC_FIGURES), seconds=round(time.perf_counter() - t0, 6))
+
+
+def _check_exhaustive(nl: Netlist, spec: Spec, t0: float) -> ProofReport:
     n = spec.n
     m = input_matrix(n)
     env = {name: m[k] for k, name in enumerate(spec.inputs)}
@@ -57,7 +135,7 @@ def prove_logic(nl: Netlist, spec: Spec, seed: int = 0) -> ProofReport:
     failures, total_bad, care_cases = _compare(nl, spec, nets, wants, env)
     return ProofReport(
         level="logic", kind="combinational", passed=total_bad == 0, cases=1 << n,
-        coverage={"exhaustive": True, "care_checks": care_cases},
+        coverage={"method": "exhaustive", "exhaustive": True, "care_checks": care_cases},
         failure_count=total_bad, failures=failures, figures=dict(LOGIC_FIGURES),
         seconds=round(time.perf_counter() - t0, 6))
 
@@ -120,7 +198,8 @@ def _check_sampled(nl: Netlist, spec: Spec, t0: float, seed: int) -> ProofReport
                 "corner_free_max": CORNER_FREE_MAX, "seed": seed}
     return ProofReport(
         level="logic", kind="combinational", passed=total_bad == 0, cases=len(vectors),
-        coverage={"exhaustive": False, "sampling": sampling, "care_checks": care_cases},
+        coverage={"method": "sampled", "exhaustive": False, "sampling": sampling,
+                  "care_checks": care_cases},
         failure_count=total_bad, failures=failures, figures=dict(LOGIC_FIGURES),
         seconds=round(time.perf_counter() - t0, 6))
 

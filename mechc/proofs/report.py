@@ -118,17 +118,31 @@ class ProofReport(Mapping):
 
 def sampled_text(cases: int, coverage: dict) -> str:
     """'1024 cases', or for a proof that is not exhaustive 'sampled 512 of 32768 cases' (and of
-    the single-input changes, where the engine says how many there are)."""
+    the single-input changes, where the engine says how many there are); a SAT proof covers
+    every vector without enumerating them, and says so."""
+    if coverage.get("method") == "sat":
+        n = max(int(cases).bit_length() - 1, 0)
+        return f"all 2^{n} vectors by a SAT miter ({coverage.get('solver', 'SAT')})"
     if coverage.get("exhaustive") is not False:
         return f"{cases} cases"
     total = coverage.get("cases_total")
-    if total is None:
-        return f"{cases} sampled cases (not exhaustive)"
-    text = (f"all {cases} cases" if cases >= total else f"sampled {cases} of {total} cases")
     tr, tr_total = coverage.get("transitions"), coverage.get("transitions_total")
+    if total is None and tr_total is None:
+        return f"{cases} sampled cases (not exhaustive)"
+    parts = []
+    if total is not None:
+        parts.append(f"all {cases} cases" if cases >= total
+                     else f"sampled {cases} of {total} cases")
     if tr is not None and tr_total is not None and tr < tr_total:
-        text += f", sampled {tr} of {tr_total} single-input changes"
-    return text + " (not exhaustive)"
+        parts.append(f"proven on {tr} of {tr_total} single-input changes, sampled")
+    if "directed_changes" in coverage:  # how the sample was led (mechc.proofs.cases)
+        parts.append(f"{coverage['directed_changes']} of them chosen to switch every cell: "
+                     f"{coverage['cells_toggled']} of {coverage['cells']} cells switched"
+                     + (f", {coverage['cells_never_toggle']} cannot switch"
+                        if coverage.get("cells_never_toggle") else "")
+                     + (f", {coverage['cells_not_reached']} not reached"
+                        if coverage.get("cells_not_reached") else ""))
+    return ", ".join(parts) + " (not exhaustive)"
 
 
 def failure_text(f: dict) -> str:

@@ -19,6 +19,9 @@ VIOLATION_FRACTION = 0.005
 VIOLATION_NO_GEOMETRY_MM = 0.1
 #: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
 MEMORY_THROW_S = 0.03
+#: How the combinational logic level checks every vector (mechc.proofs.logic): ``auto`` picks
+#: ``exhaustive`` or ``sat`` by the design's size; ``sampled`` is a seeded sample, not a proof.
+LOGIC_METHODS = ("auto", "exhaustive", "sat", "sampled")
 
 
 @dataclass(frozen=True)
@@ -27,6 +30,7 @@ class ProofSettings:
 
     tolerance: float = 0.05  # outputs within this fraction of stroke of their positions
     seed: int = 0  # for every random choice of cases
+    logic_method: str = "auto"  # logic, combinational: one of LOGIC_METHODS
     cases: int = 16  # dynamic, combinational: seeded random changes after the Gray tour
     prune: bool = False  # dynamic, combinational: per-change pruned scenes requested
     accuracy: float | None = None  # dynamic, combinational: the output error to choose for

@@ -195,9 +195,10 @@ def test_sampled_proof_reports_itself_and_catches_a_changed_spec(cli, tmp_path):
     out = tmp_path / "w.json"
     assert cli("compile", src, "-o", out, *COMPILE)[0] == 0
     report = tmp_path / "r.json"
-    code, stdout, _ = cli("simulate", out, "--level", "logic", "--report", report)
+    code, stdout, _ = cli("simulate", out, "--level", "logic", "--logic-method", "sampled",
+                          "--report", report)
     r = json.loads(report.read_text())
-    assert code == 0 and r["passed"] and r["exhaustive"] is False
+    assert code == 0 and r["passed"] and r["exhaustive"] is False and r["method"] == "sampled"
     points = {p for s in spec.values() for m, v in s["on"] + s["dc"] + s["off"]
               for p in cube_points(m, v, 30)}
     # every cube has <= 9 free inputs: all its points are enumerated, neighbours come on top
@@ -209,11 +210,16 @@ def test_sampled_proof_reports_itself_and_catches_a_changed_spec(cli, tmp_path):
     lines[k] = lines[k][:-2] + "0~"
     bad = tmp_path / "bad.pla"
     bad.write_text("\n".join(lines) + "\n")
-    code, _, _ = cli("simulate", out, "--level", "logic", "--spec", bad, "--report", report)
-    r = json.loads(report.read_text())
-    assert code != 0 and not r["passed"] and r["failure_count"] > 0
-    f = r["failures"][0]
-    assert f["output"] == "f0" and f["expected"] == 0 and f["got"] == 1
+    for method in ("sampled", "sat"):
+        code, _, _ = cli("simulate", out, "--level", "logic", "--spec", bad, "--report", report,
+                         "--logic-method", method)
+        r = json.loads(report.read_text())
+        assert code != 0 and not r["passed"] and r["failure_count"] > 0
+        f = r["failures"][0]
+        assert f["output"] == "f0" and f["expected"] == 0 and f["got"] == 1
+        # the vector lies in the cube turned off (and in no dc cube of f0's)
+        row = lines[k].split()[0]
+        assert all(c == "-" or int(c) == f["inputs"][f"x{i}"] for i, c in enumerate(row))
 
 
 def test_sampled_proof_catches_a_netlist_that_lost_a_literal(cli, tmp_path):
@@ -224,15 +230,39 @@ def test_sampled_proof_catches_a_netlist_that_lost_a_literal(cli, tmp_path):
     src = tmp_path / "w.pla"
     src.write_text(text)
     out = tmp_path / "w.json"
-    assert cli("compile", src, "-o", out, *COMPILE)[0] == 0
+    # --no-prove: this design has a static-1 hazard (f0 dips to mid-stroke when x8 moves at
+    # one vector) that the kinematic proof's changes chosen to switch every cell find and
+    # compile then refuses; the subject here is the logic level
+    assert cli("compile", src, "-o", out, *COMPILE, "--no-prove")[0] == 0
     assert cli("simulate", out, "--level", "logic")[0] == 0
+    code, stdout, _ = cli("simulate", out, "--level", "kinematic")
+    assert code == 1 and "dwell: x8 moving output f0 (expected 1)" in stdout
     design = json.loads(out.read_text())
     cell = next(c for c in design["cells"] if c["type"] == "AND" and len(c["inputs"]) >= 3)
     cell["inputs"] = cell["inputs"][1:]
     bad = tmp_path / "bad.json"
     bad.write_text(json.dumps(design))
     report = tmp_path / "r.json"
-    code, _, _ = cli("simulate", bad, "--level", "logic", "--report", report)
+    for method in ("sampled", "sat"):
+        code, _, _ = cli("simulate", bad, "--level", "logic", "--report", report,
+                         "--logic-method", method)
+        r = json.loads(report.read_text())
+        assert code != 0 and not r["passed"] and r["exhaustive"] is False
+        assert r["method"] == method
+        assert all(f["expected"] == 0 and f["got"] == 1 for f in r["failures"])
+
+
+def test_wide_pla_proved_by_sat_by_default(cli, tmp_path):
+    """Beyond the truth-table limit compile and simulate prove by a SAT miter, and say so."""
+    rng = np.random.default_rng(11)
+    text, _spec = make_pla(rng, 30, 2, "fr")
+    src = tmp_path / "w.pla"
+    src.write_text(text)
+    out = tmp_path / "w.json"
+    code, stdout, _ = cli("compile", src, "-o", out, *COMPILE)
+    assert code == 0 and "logic proof: proved, all 2^30 vectors by a SAT miter" in stdout
+    report = tmp_path / "r.json"
+    code, stdout, _ = cli("simulate", out, "--level", "logic", "--report", report)
     r = json.loads(report.read_text())
-    assert code != 0 and not r["passed"] and r["exhaustive"] is False
-    assert all(f["expected"] == 0 and f["got"] == 1 for f in r["failures"])
+    assert code == 0 and r["passed"] and r["method"] == "sat" and r["complete"]
+    assert r["cases"] == 1 << 30 and "SAT miter" in stdout
