@@ -1,0 +1,217 @@
+"""Multi-level synthesis: a logic network -> ABC's multi-level optimisation and technology
+mapping onto mechc's own cells, costed in parts (``network BLIF -> Netlist``).
+
+The two-level path builds every output as a sum of products, which for an adder, an ALU or a
+comparator means wide sums of many products and huge fan-out on every input. Here the network
+(a structural BLIF or Verilog as its author wrote it, or the minimised sums of products) goes
+through Yosys to ABC, which restructures it (AIG rewriting, choice nodes) and maps it by area
+to a Liberty library generated from mechc's cell library: one Liberty cell per logic type and
+fan-in the mapper may use, its area the mechc cell's part count (``Cell.cost``). ABC is run
+with a few area-oriented scripts and the mapping with the fewest parts is kept. Each mapped
+cell becomes a ``CellInst`` of the same library cell, so the back half of the compiler (place,
+assemble with its force budget and amplifiers, checks, proofs) is the same as for two levels.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+
+from mechc.cells.library import Library
+from mechc.errors import MechcError
+from mechc.ir.equations import Equations
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.logic.yosys import run_yosys
+
+#: Logic type -> its Liberty function over pins A, B, C, D (n: the fan-in).
+_FUNCTIONS = {
+    "AND": lambda n: "&".join("ABCD"[:n]),
+    "OR": lambda n: "|".join("ABCD"[:n]),
+    "NAND": lambda n: "!(" + "&".join("ABCD"[:n]) + ")",
+    "NOR": lambda n: "!(" + "|".join("ABCD"[:n]) + ")",
+    "XOR": lambda n: "^".join("ABCD"[:n]),
+    "XNOR": lambda n: "!(" + "^".join("ABCD"[:n]) + ")",
+    "AND_NOT": lambda n: "A&!B",
+    "OR_NOT": lambda n: "A|!B",
+    "NOT": lambda n: "!A",
+}
+#: ABC's cut-based mapper matches gates of at most this many inputs well.
+MAX_LIBERTY_FAN_IN = 4
+#: A buffer is never worth a part (a net is simply shared); its area keeps ABC from using it.
+_BUFFER = "BUF"
+
+#: Area-oriented ABC scripts tried; the mapping with the fewest mechc parts is kept.
+# ABC's resyn2 spelt out: its short aliases (b, rw, rf, resyn2) are not defined in a script
+_RESYN2 = ("balance;rewrite;refactor;balance;rewrite;rewrite,-z;balance;refactor,-z;"
+           "rewrite,-z;balance")
+SCRIPTS = (
+    "+strash;dch,-f;map,-a;topo",
+    f"+strash;{_RESYN2};dch,-f;map,-a;topo",
+    f"+strash;{_RESYN2};{_RESYN2};dch,-f;amap;topo",
+    "+strash;&get,-n;&dch,-f;&nf,-a,-R,1000;&put",
+)
+
+
+@dataclass
+class MultiLevel:
+    """The mapped network, with what chose it."""
+
+    netlist: Netlist
+    implemented: dict[str, str]
+    parts: int  # of the mapped cells (before any amplifier)
+    script: str  # the ABC script whose mapping was kept
+    tried: dict[str, int] = field(default_factory=dict)  # script -> parts
+
+
+def liberty(library: Library, fan_in: int | None = None) -> tuple[str, dict[str, tuple]]:
+    """A Liberty library of the cells the mapper may use: text, and Liberty cell name ->
+    (logic type, fan-in, mechc cell name)."""
+    cells: dict[str, tuple] = {}
+    lines = ["library(mechc) {"]
+    for t, fn in _FUNCTIONS.items():
+        n_max = 1 if t == "NOT" else (2 if t in ("AND_NOT", "OR_NOT") else
+                                      min(library.max_fan_in(t), MAX_LIBERTY_FAN_IN,
+                                          fan_in or MAX_LIBERTY_FAN_IN))
+        for n in range(1 if t == "NOT" else 2, n_max + 1):
+            cls = library.for_type(t, n)
+            if cls is None:
+                continue
+            name = f"{t}{n}"
+            cells[name] = (t, n, cls.name)
+            pins = " ".join(f"pin({p}) {{ direction: input; }}" for p in "ABCD"[:n])
+            lines.append(f"  cell({name}) {{ area: {cls.cost(n)}; {pins} "
+                         f"pin(Y) {{ direction: output; function: \"{fn(n)}\"; }} }}")
+    lines.append(f"  cell({_BUFFER}) {{ area: 1000; pin(A) {{ direction: input; }} "
+                 "pin(Y) { direction: output; function: \"A\"; } }")
+    lines.append("}")
+    return "\n".join(lines) + "\n", cells
+
+
+def equations_blif(eq: Equations) -> str:
+    """The minimised sums of products as a BLIF network (one ``.names`` per output), the
+    start of multi-level synthesis for a spec given as functions (.bool, .pla)."""
+    n = len(eq.inputs)
+    lines = [".model top", ".inputs " + " ".join(eq.inputs),
+             ".outputs " + " ".join(eq.outputs)]
+    for o in eq.outputs:
+        lines.append(".names " + " ".join(eq.inputs + [o]))
+        lines += [f"{c.to_string(n)} 1" for c in eq.covers[o].cubes]
+    return "\n".join(lines + [".end"]) + "\n"
+
+
+def map_multilevel(blif: str, inputs: list[str], outputs: list[str], library: Library,
+                   fan_in: int | None = None) -> MultiLevel:
+    """Optimise and map the BLIF network (model ``top``) onto the library; the cheapest of
+    :data:`SCRIPTS` in parts."""
+    lib_text, cells = liberty(library, fan_in)
+    script = ["read_blif input.blif", "hierarchy -top top", "flatten",
+              "synth -flatten -top top", "design -save base"]
+    for k, s in enumerate(SCRIPTS):
+        script += ["design -load base", f"abc -liberty mech.lib -script {s}",
+                   "opt_clean -purge", f"write_json mapped{k}.json"]
+    want = [f"mapped{k}.json" for k in range(len(SCRIPTS))]
+    res = run_yosys("\n".join(script) + "\n", {"input.blif": blif, "mech.lib": lib_text}, want)
+    if res.returncode != 0 or not res.files:
+        tail = " ".join(ln for ln in res.log.splitlines() if "ERROR" in ln)[:400]
+        raise MechcError(f"multi-level synthesis failed in Yosys (exit {res.returncode}): "
+                         f"{tail or res.log[-400:]}")
+    best: MultiLevel | None = None
+    tried: dict[str, int] = {}
+    for k, s in enumerate(SCRIPTS):
+        text = res.files.get(f"mapped{k}.json")
+        if text is None:
+            continue
+        nl = netlist_from_json(json.loads(text), inputs, outputs, cells, library)
+        parts = sum(library[c.cell].cost(len(c.inputs)) for c in nl.cells.values())
+        tried[s] = parts
+        if best is None or parts < best.parts:
+            best = MultiLevel(nl, {}, parts, s)
+    assert best is not None
+    best.tried = tried
+    depth = best.netlist.depth()
+    for o, net in best.netlist.outputs.items():
+        drv = best.netlist.driver[net][0]
+        best.implemented[o] = (f"multi-level network, depth {depth.get(drv, 0)}"
+                               if drv in best.netlist.cells else net)
+    return best
+
+
+def netlist_from_json(doc: dict, inputs: list[str], outputs: list[str],
+                      cells: dict[str, tuple], library: Library) -> Netlist:
+    """Yosys' JSON of the mapped module -> a mechc netlist (cells numbered in topological
+    order; an output driven by a cell gives its name to that net)."""
+    mod = doc["modules"]["top"]
+    net_of: dict = {}  # Yosys bit -> mechc net name
+    for name in inputs:
+        for b in mod["ports"][name]["bits"]:
+            net_of[b] = name
+    driver: dict = {}  # bit -> yosys cell name
+    for cname, c in mod["cells"].items():
+        if c["type"] not in cells and c["type"] != _BUFFER:
+            raise MechcError(f"Yosys mapped to an unknown cell {c['type']}")
+        driver[c["connections"]["Y"][0]] = cname
+    out_bits = {o: mod["ports"][o]["bits"][0] for o in outputs}
+    named: dict = {}
+    for o, b in out_bits.items():
+        if b in driver and b not in named:
+            named[b] = o
+    nl = Netlist(inputs)
+    counter = {"cell": 0, "net": 0}
+    taken = set(inputs) | set(outputs)
+
+    def fresh() -> str:
+        while True:
+            counter["net"] += 1
+            net = f"n{counter['net']}"
+            if net not in taken:
+                return net
+
+    def add(cid: str, type_name: str, ins: tuple[str, ...], net: str, params: dict) -> None:
+        cls = library.for_type(type_name, len(ins))
+        nl.add_cell(CellInst(cid, cls.name, type_name, ins, (net,), params),
+                    pin_names=cls.input_names(len(ins)), out_pins=list(cls.outputs))
+
+    def const(value: int) -> str:
+        key = f"const{value}"
+        if key not in net_of:
+            counter["cell"] += 1
+            net = fresh()
+            add(f"c{counter['cell']}", "CONST", (), net, {"value": value})
+            net_of[key] = net
+        return net_of[key]
+
+    def build(bit) -> str:  # iterative depth-first: chains may be long
+        stack = [bit]
+        while stack:
+            b = stack[-1]
+            if b in net_of:
+                stack.pop()
+                continue
+            if b in ("0", "1"):
+                net_of[b] = const(int(b))
+                stack.pop()
+                continue
+            if b not in driver:
+                raise MechcError(f"Yosys left net bit {b} undriven")
+            c = mod["cells"][driver[b]]
+            pins = [p for p in "ABCD" if p in c["connections"]]
+            ins = [c["connections"][p][0] for p in pins]
+            todo = [i for i in ins if i not in net_of]
+            if todo:
+                stack.extend(todo)
+                continue
+            stack.pop()
+            if c["type"] == _BUFFER:
+                net_of[b] = net_of[ins[0]]
+                continue
+            t, _n, _cell = cells[c["type"]]
+            counter["cell"] += 1
+            net = named.get(b) or fresh()
+            add(f"c{counter['cell']}", t, tuple(net_of[i] for i in ins), net, {})
+            net_of[b] = net
+        return net_of[bit]
+
+    for o in outputs:
+        nl.set_output(o, build(out_bits[o]))
+    nl.check()
+    return nl
