@@ -20,13 +20,18 @@ from mechc.ir.layout import Layout
 from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
-from mechc.passes.amplify import amplify_nets, nets_short_of_force, snap_outputs
+from mechc.passes.amplify import (
+    amplify_nets,
+    nets_overstressed,
+    nets_short_of_force,
+    snap_outputs,
+)
 from mechc.passes.assemble import MechOptions, assemble_mechanism
 from mechc.passes.checks import run_design_checks
 from mechc.passes.flowtable import SynthOptions, derive_equations, synthesise_table
 from mechc.passes.map import MapOptions, Mapped, map_equations, map_sequential
 from mechc.passes.minimise import MinimiseOptions, minimise
-from mechc.passes.multilevel import equations_blif, map_multilevel
+from mechc.passes.multilevel import equations_blif, map_multilevel_hazard_free
 from mechc.passes.ordering import decide_ordering
 from mechc.passes.place import place
 from mechc.passes.route import interconnect_stats
@@ -118,12 +123,14 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
     if levels in ("multi", "auto"):
         source = "structure" if spec.structure else "sums of products"
         blif = spec.structure or equations_blif(eq)
-        ml = stage("multi-level", map_multilevel, blif, list(spec.inputs),
-                   list(spec.outputs), lib, opts.map.fan_in)
+        ml = stage("multi-level", map_multilevel_hazard_free, blif, list(spec.inputs),
+                   list(spec.outputs), lib, opts.map, opts.minimise, mapped.netlist,
+                   opts.map.fan_in)
         layout = stage("place", place, ml.netlist)
         built["multi"] = (*stage("assemble", assemble_powered, ml.netlist, lib, opts, layout),
                           Mapped(ml.netlist, ml.implemented))
-        info = {"from": source, "abc_script": ml.script, "mapped_parts": ml.parts}
+        info = {"from": source, "method": ml.script, "mapped_parts": ml.parts,
+                "tried": ml.tried, "two_level_outputs": ml.two_level_outputs}
     parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
     chosen = min(parts, key=lambda k: (parts[k], k != "2"))
     nl, layout, mech, amps, kept = built[chosen]
@@ -238,7 +245,7 @@ def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
         mech = assemble_mechanism(nl, layout, lib, opts.mech)
         if not opts.amplify or attempt == MAX_AMPLIFY_ROUNDS:
             break
-        short = nets_short_of_force(nl, mech, lib)
+        short = nets_short_of_force(nl, mech, lib) or nets_overstressed(nl, mech)
         if not short:
             break
         amps.update(short)

@@ -15,13 +15,19 @@ assemble with its force budget and amplifiers, checks, proofs) is the same as fo
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from mechc.cells.library import Library
 from mechc.errors import MechcError
 from mechc.ir.equations import Equations
 from mechc.ir.netlist import CellInst, Netlist
+from mechc.ir.spec import OutputSpec, Spec
+from mechc.logic.cubes import Cube
 from mechc.logic.yosys import run_yosys
+from mechc.passes.map import map_equations
+from mechc.passes.map_sop import MapOptions
+from mechc.passes.minimise import MinimiseOptions, minimise
+from mechc.passes.ternary import static_hazards
 
 #: Logic type -> its Liberty function over pins A, B, C, D (n: the fan-in).
 _FUNCTIONS = {
@@ -61,6 +67,7 @@ class MultiLevel:
     parts: int  # of the mapped cells (before any amplifier)
     script: str  # the ABC script whose mapping was kept
     tried: dict[str, int] = field(default_factory=dict)  # script -> parts
+    two_level_outputs: list[str] = field(default_factory=list)  # rebuilt for a hazard
 
 
 def liberty(library: Library, fan_in: int | None = None) -> tuple[str, dict[str, tuple]]:
@@ -134,6 +141,216 @@ def map_multilevel(blif: str, inputs: list[str], outputs: list[str], library: Li
         best.implemented[o] = (f"multi-level network, depth {depth.get(drv, 0)}"
                                if drv in best.netlist.cells else net)
     return best
+
+
+#: Cut sizes tried for the hazard-free composition (each node a function of at most K nets).
+LUT_SIZES = (3, 4)
+
+
+def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
+                               library: Library, map_opts: MapOptions,
+                               min_opts: MinimiseOptions, two_level: Netlist | None,
+                               fan_in: int | None = None) -> MultiLevel:
+    """Multi-level logic a mechanism can move without glitches: the candidates are ABC's area
+    mapping onto the cells (:func:`map_multilevel`) and ABC's K-input cut decomposition with
+    every node built by mechc's own two-level minimiser and mapper (a hazard-free cover of a
+    function of at most K nets); each is checked by ternary simulation, and every output that
+    still has a static hazard is built from the two-level netlist instead. The candidate with
+    the fewest parts is kept."""
+    cands: list[MultiLevel] = []
+    cands.append(map_multilevel(blif, inputs, outputs, library, fan_in))
+    script = ["read_blif input.blif", "hierarchy -top top", "flatten",
+              "synth -flatten -top top", "design -save base"]
+    for k in LUT_SIZES:
+        script += ["design -load base", f"abc -lut {k}", "opt_clean -purge",
+                   f"write_json lut{k}.json"]
+    res = run_yosys("\n".join(script) + "\n", {"input.blif": blif},
+                    [f"lut{k}.json" for k in LUT_SIZES])
+    cache: dict = {}
+    for k in LUT_SIZES:
+        text = res.files.get(f"lut{k}.json")
+        if text is None:
+            continue
+        nl = compose_luts(json.loads(text), inputs, outputs, library, map_opts, min_opts, cache)
+        cands.append(MultiLevel(nl, {}, _parts(nl, library), f"abc -lut {k}, nodes by mechc"))
+    best: MultiLevel | None = None
+    tried: dict[str, int] = {}
+    for c in cands:
+        bad = static_hazards(c.netlist)
+        if bad and two_level is not None:
+            c.netlist = with_two_level(c.netlist, two_level, sorted(bad))
+            c.parts = _parts(c.netlist, library)
+            c.two_level_outputs = sorted(bad)
+        elif bad:
+            continue
+        tried[c.script] = c.parts
+        if best is None or c.parts < best.parts:
+            best = c
+    if best is None:
+        raise MechcError("multi-level synthesis found no hazard-free network")
+    best.tried = tried
+    _describe(best)
+    return best
+
+
+def _parts(nl: Netlist, library: Library) -> int:
+    return sum(library[c.cell].cost(len(c.inputs)) for c in nl.cells.values())
+
+
+def _describe(ml: MultiLevel) -> None:
+    depth = ml.netlist.depth()
+    ml.implemented = {}
+    for o, net in ml.netlist.outputs.items():
+        drv = ml.netlist.driver[net][0]
+        how = ("two-level cone (the multi-level one had a static hazard)"
+               if o in ml.two_level_outputs else "multi-level network")
+        ml.implemented[o] = (f"{how}, depth {depth.get(drv, 0)}"
+                             if drv in ml.netlist.cells else net)
+
+
+def compose_luts(doc: dict, inputs: list[str], outputs: list[str], library: Library,
+                 map_opts: MapOptions, min_opts: MinimiseOptions, cache: dict) -> Netlist:
+    """ABC's cut network (``$lut`` cells) -> a netlist in which each node is its function's
+    minimised hazard-free cover, mapped by the two-level mapper (cached by truth table)."""
+    mod = doc["modules"]["top"]
+    net_of: dict = {}
+    for name in inputs:
+        for b in mod["ports"][name]["bits"]:
+            net_of[b] = name
+    driver = {c["connections"]["Y"][0]: c for c in mod["cells"].values()}
+    for c in mod["cells"].values():
+        if c["type"] != "$lut":
+            raise MechcError(f"Yosys left a {c['type']} cell in its cut network")
+    out_bits = {o: mod["ports"][o]["bits"][0] for o in outputs}
+    named: dict = {}
+    for o, b in out_bits.items():
+        if b in driver and b not in named:
+            named[b] = o
+    cells: list[CellInst] = []
+    taken = set(inputs) | set(outputs)
+    counter = {"cell": 0, "net": 0}
+
+    def fresh() -> str:
+        while True:
+            counter["net"] += 1
+            net = f"n{counter['net']}"
+            if net not in taken:
+                return net
+
+    def node(table: str, ins: list[str], net_name) -> str:
+        k = len(ins)
+        if table not in cache:
+            cache[table] = _node_netlist(table, k, library, map_opts, min_opts)
+        sub = cache[table]
+        rename = {f"x{i}": ins[i] for i in range(k)}
+        out_net = sub.outputs["y"]
+        if out_net in rename:
+            return rename[out_net]
+        for c in sub.topo_cells():
+            for net in c.outputs:
+                rename[net] = (net_name() if net == out_net else fresh())
+            counter["cell"] += 1
+            cells.append(CellInst(f"c{counter['cell']}", c.cell, c.type,
+                                  tuple(rename[n] for n in c.inputs),
+                                  tuple(rename[n] for n in c.outputs), dict(c.params)))
+        return rename[out_net]
+
+    def build(bit) -> str:
+        stack = [bit]
+        while stack:
+            b = stack[-1]
+            if b in net_of:
+                stack.pop()
+                continue
+            if b in ("0", "1"):
+                net_of[b] = node("1" if b == "1" else "0", [], fresh)
+                stack.pop()
+                continue
+            c = driver.get(b)
+            if c is None:
+                raise MechcError(f"Yosys left net bit {b} undriven")
+            ins = c["connections"]["A"]
+            todo = [i for i in ins if i not in net_of]
+            if todo:
+                stack.extend(todo)
+                continue
+            stack.pop()
+            table = str(c["parameters"]["LUT"])
+            width = len(ins)
+            table = table.zfill(1 << width)[-(1 << width):]
+            net_of[b] = node(table, [net_of[i] for i in ins],
+                             (lambda b=b: named[b]) if b in named else fresh)
+        return net_of[bit]
+
+    outs = {o: build(b) for o, b in out_bits.items()}
+    nl = Netlist(inputs)
+    for c in cells:
+        cls = library[c.cell]
+        nl.add_cell(c, pin_names=cls.input_names(len(c.inputs)), out_pins=list(cls.outputs))
+    for o, net in outs.items():
+        nl.set_output(o, net)
+    nl.check()
+    return nl
+
+
+def _node_netlist(table: str, k: int, library: Library, map_opts: MapOptions,
+                  min_opts: MinimiseOptions) -> Netlist:
+    """One cut node (Yosys' LUT parameter: bit j is the output for input value j, input 0
+    the least significant) minimised and mapped over inputs x0..x(k-1)."""
+    names = [f"x{i}" for i in range(k)]
+    on = []
+    for j in range(1 << k):
+        if table[len(table) - 1 - j] == "1":
+            value = sum(1 << (k - 1 - i) for i in range(k) if j >> i & 1)
+            on.append(Cube((1 << k) - 1, value))
+    spec = Spec("<node>", "pla", names, ["y"], {"y": OutputSpec("y", on=on)})
+    eq = minimise(spec, min_opts)
+    opts = replace(map_opts, target="conventional")
+    return map_equations(eq, library, opts).netlist
+
+
+def with_two_level(ml: Netlist, two: Netlist, outputs: list[str]) -> Netlist:
+    """``ml`` with the named outputs built by their cones of the two-level netlist instead
+    (its cells renamed apart); cells no output needs any more are dropped."""
+    keep_outputs = {o: net for o, net in ml.outputs.items() if o not in outputs}
+    live = _cone(ml, keep_outputs.values())
+    two_live = _cone(two, [two.outputs[o] for o in outputs])
+    taken = set(ml.inputs) | set(ml.driver) | set(ml.outputs)
+    rename = {x: x for x in two.inputs}
+    cells = [ml.cells[c] for c in ml.cells if c in live]
+    k = len(ml.cells)
+    for c in two.topo_cells():
+        if c.id not in two_live:
+            continue
+        for net in c.outputs:
+            name = net if net in outputs and net not in taken else f"t_{net}"
+            while name in taken:
+                name = "t_" + name
+            taken.add(name)
+            rename[net] = name
+        k += 1
+        cells.append(CellInst(f"c{k}", c.cell, c.type, tuple(rename[n] for n in c.inputs),
+                              tuple(rename[n] for n in c.outputs), dict(c.params)))
+    nl = Netlist(ml.inputs)
+    for c in cells:
+        nl.add_cell(c)
+    for o in ml.outputs:
+        nl.set_output(o, keep_outputs[o] if o in keep_outputs else rename[two.outputs[o]])
+    nl.check()
+    return nl
+
+
+def _cone(nl: Netlist, nets) -> set[str]:
+    """Cells some of ``nets`` depend on."""
+    seen: set[str] = set()
+    todo = [nl.driver[n][0] for n in nets]
+    while todo:
+        cid = todo.pop()
+        if cid in seen or cid not in nl.cells:
+            continue
+        seen.add(cid)
+        todo.extend(nl.driver[n][0] for n in nl.cells[cid].inputs)
+    return seen
 
 
 def netlist_from_json(doc: dict, inputs: list[str], outputs: list[str],
