@@ -107,18 +107,18 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
                  stage) -> tuple:
     """Place and assemble the two-level mapping, the multi-level one, or (``auto``) both,
     keeping the one with fewer parts after assembly (amplifiers counted; a tie keeps two
-    levels). Returns netlist, layout, mechanism, amplified nets, the Mapped kept and the
-    ``levels`` stats (which was chosen, both part counts), empty for two levels alone."""
+    levels). Amplifying only adds cells, so a mapping's parts before assembly are a lower
+    bound of its parts after: where the assembled multi-level design already has fewer parts
+    than the two-level mapping, the two-level design is not assembled (its count is then that
+    bound, and the stats say so). Returns netlist, layout, mechanism, amplified nets, the
+    Mapped kept and the ``levels`` stats (which was chosen, both part counts), empty for two
+    levels alone."""
     levels = opts.levels
     if levels not in ("2", "multi", "auto"):
         raise ValueError(f"levels must be 2, multi or auto, not {levels!r}")
     if opts.map.target != "conventional" and levels == "auto":
         levels = "2"  # threshold mapping is two-level; multi-level maps to AND/OR-family cells
     built: dict[str, tuple] = {}
-    if levels in ("2", "auto"):
-        layout = stage("place", place, mapped.netlist)
-        built["2"] = (*stage("assemble", assemble_powered, mapped.netlist, lib, opts, layout),
-                      mapped)
     info: dict = {}
     if levels in ("multi", "auto"):
         source = "structure" if spec.structure else "sums of products"
@@ -132,12 +132,23 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
         info = {"from": source, "method": ml.script, "mapped_parts": ml.parts,
                 "tried": ml.tried, "two_level_outputs": ml.two_level_outputs}
     parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
-    chosen = min(parts, key=lambda k: (parts[k], k != "2"))
+    two_mapped = netlist_parts(mapped.netlist, lib)
+    two_level = "assembled"
+    if levels == "auto" and parts["multi"] < two_mapped:
+        two_level = "mapped only: its parts before amplifiers, a lower bound"
+        parts["2"] = two_mapped
+    elif levels in ("2", "auto"):
+        layout = stage("place", place, mapped.netlist)
+        built["2"] = (*stage("assemble", assemble_powered, mapped.netlist, lib, opts, layout),
+                      mapped)
+        parts["2"] = netlist_parts(built["2"][0], lib)
+    chosen = min(built, key=lambda k: (parts[k], k != "2"))
     nl, layout, mech, amps, kept = built[chosen]
     if opts.levels == "2":
         return nl, layout, mech, amps, kept, {}
     return nl, layout, mech, amps, kept, {"asked": opts.levels, "chosen": chosen,
-                                           "parts": parts, "multi": info}
+                                           "parts": {k: parts[k] for k in sorted(parts)},
+                                           "two_level": two_level, "multi": info}
 
 
 #: Flow tables with at most this many state variables try every memory polarity.

@@ -270,6 +270,8 @@ def details(design: Design, args: argparse.Namespace) -> list[str]:
             lines.append(f"essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
                          f"{h['to']}: {h['requires']}")
         lines += ordering_lines(st.get("sequential", {}).get("ordering"))
+    if st.get("levels"):
+        lines.append(levels_line(st["levels"]))
     if "planes" in st:
         lines.append(f"interconnect: {st['rods']} rods, {st['rod_length_mm']:g} mm of rod, "
                      f"{st['bends']} bends, {st['planes']['count']} planes "
@@ -282,6 +284,19 @@ def details(design: Design, args: argparse.Namespace) -> list[str]:
         lines.append(f"... and {len(amps) - SHORT_OUTPUTS} more amplified nets "
                      "(stats.amplified in the design file)")
     return lines
+
+
+def levels_line(lv: dict) -> str:
+    """Which logic depth was built and what each cost: 'levels: multi-level chosen (476 parts;
+    two-level 1876)'."""
+    names = {"2": "two-level", "multi": "multi-level"}
+    others = "; ".join(f"{names[k]} {v}" for k, v in lv["parts"].items() if k != lv["chosen"])
+    line = (f"levels: {names[lv['chosen']]} {'chosen' if lv['asked'] == 'auto' else 'asked'} "
+            f"({lv['parts'][lv['chosen']]} parts{'; ' + others if others else ''})")
+    back = lv.get("multi", {}).get("two_level_outputs")
+    if lv["chosen"] == "multi" and back:
+        line += f"; built two-level for a static hazard: {', '.join(back)}"
+    return line
 
 
 def plane_list(used: list[int]) -> str:
