@@ -141,6 +141,7 @@ def yosys_error(log: str, lines: list[str]) -> tuple[int, int, str]:
 
 def _quoted(msg: str) -> list[str]:
     out = [m.group(1).lstrip("\\") for m in re.finditer(r"`([^']+)'", msg)]
+    out += re.findall(r"\\([A-Za-z_]\w*)", msg)  # Yosys' escaped names: m.\w
     out += [m.group(1) for m in re.finditer(r"unexpected '([^']+)'", msg)]
     out += [m.group(1) for m in re.finditer(r"unexpected (TOK_\w+|\w+)", msg)
             if not m.group(1).startswith("TOK_")]
