@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 
 from mechc.cells.library import Library, load_library
 from mechc.cells.sources import cell_sources
+from mechc.errors import MechcError
 from mechc.ir.design import Design
 from mechc.ir.equations import Equations
 from mechc.ir.layout import Layout
@@ -120,12 +121,19 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
         levels = "2"  # threshold mapping is two-level; multi-level maps to AND/OR-family cells
     built: dict[str, tuple] = {}
     info: dict = {}
+    ml = None
     if levels in ("multi", "auto"):
         source = "structure" if spec.structure else "sums of products"
         blif = spec.structure or equations_blif(eq)
-        ml = stage("multi-level", map_multilevel_hazard_free, blif, list(spec.inputs),
-                   list(spec.outputs), lib, opts.map, opts.minimise, mapped.netlist,
-                   opts.map.fan_in)
+        try:
+            ml = stage("multi-level", map_multilevel_hazard_free, blif, list(spec.inputs),
+                       list(spec.outputs), lib, opts.map, opts.minimise, mapped.netlist,
+                       opts.map.fan_in)
+        except MechcError as e:
+            if levels == "multi":
+                raise
+            ml, info = None, {"failed": str(e)}  # auto: two levels, and the summary says why
+    if levels in ("multi", "auto") and ml is not None:
         layout = stage("place", place, ml.netlist)
         built["multi"] = (*stage("assemble", assemble_powered, ml.netlist, lib, opts, layout),
                           Mapped(ml.netlist, ml.implemented))
@@ -134,7 +142,7 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
     parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
     two_mapped = netlist_parts(mapped.netlist, lib)
     two_level = "assembled"
-    if levels == "auto" and parts["multi"] < two_mapped:
+    if levels == "auto" and "multi" in parts and parts["multi"] < two_mapped:
         two_level = "mapped only: its parts before amplifiers, a lower bound"
         parts["2"] = two_mapped
     elif levels in ("2", "auto"):

@@ -288,14 +288,19 @@ def details(design: Design, args: argparse.Namespace) -> list[str]:
 
 def levels_line(lv: dict) -> str:
     """Which logic depth was built and what each cost: 'levels: multi-level chosen (476 parts;
-    two-level 1876)'."""
+    two-level 1876)'; a two-level design not assembled shows its lower bound, '>= 1210'."""
     names = {"2": "two-level", "multi": "multi-level"}
-    others = "; ".join(f"{names[k]} {v}" for k, v in lv["parts"].items() if k != lv["chosen"])
+    bound = ">= " if lv.get("two_level", "assembled") != "assembled" else ""
+    others = "; ".join(f"{names[k]} {bound if k == '2' else ''}{v}"
+                       for k, v in lv["parts"].items() if k != lv["chosen"])
     line = (f"levels: {names[lv['chosen']]} {'chosen' if lv['asked'] == 'auto' else 'asked'} "
             f"({lv['parts'][lv['chosen']]} parts{'; ' + others if others else ''})")
-    back = lv.get("multi", {}).get("two_level_outputs")
-    if lv["chosen"] == "multi" and back:
-        line += f"; built two-level for a static hazard: {', '.join(back)}"
+    multi = lv.get("multi", {})
+    if lv["chosen"] == "multi" and multi.get("two_level_outputs"):
+        line += ("; built two-level for a static hazard: "
+                 + ", ".join(multi["two_level_outputs"]))
+    if multi.get("failed"):
+        line += f"; multi-level failed: {multi['failed']}"
     return line
 
 
