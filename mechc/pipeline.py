@@ -128,7 +128,7 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
         try:
             ml = stage("multi-level", map_multilevel_hazard_free, blif, list(spec.inputs),
                        list(spec.outputs), lib, opts.map, opts.minimise, mapped.netlist,
-                       opts.map.fan_in)
+                       opts.map.fan_in, eq)
         except MechcError as e:
             if levels == "multi":
                 raise

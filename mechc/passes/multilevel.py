@@ -24,6 +24,7 @@ from mechc.ir.netlist import CellInst, Netlist
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube
 from mechc.logic.yosys import run_yosys
+from mechc.passes.factor import factored_netlist
 from mechc.passes.map import map_equations
 from mechc.passes.map_sop import MapOptions
 from mechc.passes.minimise import MinimiseOptions, minimise
@@ -150,14 +151,24 @@ LUT_SIZES = (3, 4)
 def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
                                library: Library, map_opts: MapOptions,
                                min_opts: MinimiseOptions, two_level: Netlist | None,
-                               fan_in: int | None = None) -> MultiLevel:
+                               fan_in: int | None = None,
+                               eq: Equations | None = None) -> MultiLevel:
     """Multi-level logic a mechanism can move without glitches: the candidates are ABC's area
     mapping onto the cells (:func:`map_multilevel`) and ABC's K-input cut decomposition with
     every node built by mechc's own two-level minimiser and mapper (a hazard-free cover of a
     function of at most K nets); each is checked by ternary simulation, and every output that
-    still has a static hazard is built from the two-level netlist instead. The candidate with
+    still has a static hazard is built hazard-free instead: from the two-level netlist, or
+    from the algebraically factored hazard-free covers (``eq`` given; :mod:`factor`), whichever
+    has fewer parts; the factored covers are also a candidate of their own. The candidate with
     the fewest parts is kept."""
     cands: list[MultiLevel] = []
+    if eq is not None:
+        fac = factored_netlist(eq, library, map_opts)
+        if not static_hazards(fac):  # algebraic factoring keeps hazard freedom: checked
+            cands.append(MultiLevel(fac, {}, _parts(fac, library),
+                                    "hazard-free covers, factored by mechc"))
+            if two_level is None or _parts(fac, library) < _parts(two_level, library):
+                two_level = fac
     cands.append(map_multilevel(blif, inputs, outputs, library, fan_in))
     script = ["read_blif input.blif", "hierarchy -top top", "flatten",
               "synth -flatten -top top", "design -save base"]
@@ -202,7 +213,7 @@ def _describe(ml: MultiLevel) -> None:
     ml.implemented = {}
     for o, net in ml.netlist.outputs.items():
         drv = ml.netlist.driver[net][0]
-        how = ("two-level cone (the multi-level one had a static hazard)"
+        how = ("hazard-free cone (the multi-level one had a static hazard)"
                if o in ml.two_level_outputs else "multi-level network")
         ml.implemented[o] = (f"{how}, depth {depth.get(drv, 0)}"
                              if drv in ml.netlist.cells else net)
