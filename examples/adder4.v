@@ -1,5 +1,6 @@
 // 4-bit ripple-carry adder: S = A + B + CI, CO the carry out.
-// Written as four full adders so the carry chain is the structure the author gave it.
+// Written as four full adders so the carry chain is the structure the author gave it; each
+// carry is the majority of its three inputs, a form with no static hazard.
 module adder4 (
     input  [3:0] A,
     input  [3:0] B,
@@ -13,7 +14,7 @@ module adder4 (
     generate
         for (i = 0; i < 4; i = i + 1) begin : bit_slice
             assign S[i]     = A[i] ^ B[i] ^ c[i];
-            assign c[i + 1] = (A[i] & B[i]) | (c[i] & (A[i] ^ B[i]));
+            assign c[i + 1] = (A[i] & B[i]) | (A[i] & c[i]) | (B[i] & c[i]);
         end
     endgenerate
     assign CO = c[4];
