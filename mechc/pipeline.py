@@ -247,7 +247,7 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
 
 
 #: Rounds of "synthesise, amplify the nets whose forces fail" before giving up.
-MAX_AMPLIFY_ROUNDS = 3
+MAX_AMPLIFY_ROUNDS = 6  # a deep chain is relieved one level of amplifiers a round
 
 
 def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
