@@ -14,18 +14,25 @@ from dataclasses import dataclass, field
 
 from mechc.cells.library import Library, load_library
 from mechc.cells.sources import cell_sources
+from mechc.errors import MechcError
 from mechc.ir.design import Design
 from mechc.ir.equations import Equations
 from mechc.ir.layout import Layout
 from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
-from mechc.passes.amplify import amplify_nets, nets_short_of_force, snap_outputs
+from mechc.passes.amplify import (
+    amplify_nets,
+    nets_overstressed,
+    nets_short_of_force,
+    snap_outputs,
+)
 from mechc.passes.assemble import MechOptions, assemble_mechanism
 from mechc.passes.checks import run_design_checks
 from mechc.passes.flowtable import SynthOptions, derive_equations, synthesise_table
-from mechc.passes.map import MapOptions, map_equations, map_sequential
+from mechc.passes.map import MapOptions, Mapped, map_equations, map_sequential
 from mechc.passes.minimise import MinimiseOptions, minimise
+from mechc.passes.multilevel import equations_blif, map_multilevel_hazard_free
 from mechc.passes.ordering import decide_ordering
 from mechc.passes.place import place
 from mechc.passes.route import interconnect_stats
@@ -39,6 +46,9 @@ class CompileOptions:
     mech: MechOptions = field(default_factory=MechOptions)
     cell_dirs: tuple[str, ...] = ()
     amplify: bool = True  # insert AMPLIFIERs where forces fail or an output must snap
+    # "2": sums of products; "multi": multi-level (Yosys/ABC, mapped by parts); "auto": both
+    # built and assembled, the one with fewer parts kept (passes/multilevel.py)
+    levels: str = "2"
     timings: bool = False  # record seconds per stage in the JSON (makes output non-reproducible)
 
 
@@ -73,10 +83,10 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
     mapped = stage("map", map_equations, eq, lib, opts.map)
     if getattr(mapped, "equations", None) is not None:
         eq = mapped.equations  # the mapper built the alternative covers (fewer parts)
-    layout = stage("place", place, mapped.netlist)
-    nl, layout, mech, amps = stage("assemble", assemble_powered, mapped.netlist, lib, opts,
-                                   layout)
+    nl, layout, mech, amps, mapped, levels = build_levels(spec, eq, mapped, lib, opts, stage)
     stats = design_stats(eq, nl, lib, layout)
+    if levels:
+        stats["levels"] = levels
     stats.update(interconnect_stats(mech))
     if getattr(spec, "display", None):
         stats["names"] = dict(spec.display)  # safe identifier -> the spec file's own name
@@ -87,6 +97,66 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
     design.cell_sources = cell_sources(nl, lib)
     stage("check", run_design_checks, design, lib)
     return design
+
+
+def netlist_parts(nl: Netlist, lib: Library) -> int:
+    """Parts of every cell of a netlist (the library cells' ``cost``), amplifiers included."""
+    return sum(lib[c.cell].cost(len(c.inputs)) for c in nl.cells.values())
+
+
+def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileOptions,
+                 stage) -> tuple:
+    """Place and assemble the two-level mapping, the multi-level one, or (``auto``) both,
+    keeping the one with fewer parts after assembly (amplifiers counted; a tie keeps two
+    levels). Amplifying only adds cells, so a mapping's parts before assembly are a lower
+    bound of its parts after: where the assembled multi-level design already has fewer parts
+    than the two-level mapping, the two-level design is not assembled (its count is then that
+    bound, and the stats say so). Returns netlist, layout, mechanism, amplified nets, the
+    Mapped kept and the ``levels`` stats (which was chosen, both part counts), empty for two
+    levels alone."""
+    levels = opts.levels
+    if levels not in ("2", "multi", "auto"):
+        raise ValueError(f"levels must be 2, multi or auto, not {levels!r}")
+    if opts.map.target != "conventional" and levels == "auto":
+        levels = "2"  # threshold mapping is two-level; multi-level maps to AND/OR-family cells
+    built: dict[str, tuple] = {}
+    info: dict = {}
+    ml = None
+    if levels in ("multi", "auto"):
+        source = "structure" if spec.structure else "sums of products"
+        blif = spec.structure or equations_blif(eq)
+        try:
+            ml = stage("multi-level", map_multilevel_hazard_free, blif, list(spec.inputs),
+                       list(spec.outputs), lib, opts.map, opts.minimise, mapped.netlist,
+                       opts.map.fan_in, eq)
+        except MechcError as e:
+            if levels == "multi":
+                raise
+            ml, info = None, {"failed": str(e)}  # auto: two levels, and the summary says why
+    if levels in ("multi", "auto") and ml is not None:
+        layout = stage("place", place, ml.netlist)
+        built["multi"] = (*stage("assemble", assemble_powered, ml.netlist, lib, opts, layout),
+                          Mapped(ml.netlist, ml.implemented))
+        info = {"from": source, "method": ml.script, "mapped_parts": ml.parts,
+                "tried": ml.tried, "two_level_outputs": ml.two_level_outputs}
+    parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
+    two_mapped = netlist_parts(mapped.netlist, lib)
+    two_level = "assembled"
+    if levels == "auto" and "multi" in parts and parts["multi"] < two_mapped:
+        two_level = "mapped only: its parts before amplifiers, a lower bound"
+        parts["2"] = two_mapped
+    elif levels in ("2", "auto"):
+        layout = stage("place", place, mapped.netlist)
+        built["2"] = (*stage("assemble", assemble_powered, mapped.netlist, lib, opts, layout),
+                      mapped)
+        parts["2"] = netlist_parts(built["2"][0], lib)
+    chosen = min(built, key=lambda k: (parts[k], k != "2"))
+    nl, layout, mech, amps, kept = built[chosen]
+    if opts.levels == "2":
+        return nl, layout, mech, amps, kept, {}
+    return nl, layout, mech, amps, kept, {"asked": opts.levels, "chosen": chosen,
+                                           "parts": {k: parts[k] for k in sorted(parts)},
+                                           "two_level": two_level, "multi": info}
 
 
 #: Flow tables with at most this many state variables try every memory polarity.
@@ -177,7 +247,7 @@ def compile_sequential(spec, opts: CompileOptions | None = None, library: Librar
 
 
 #: Rounds of "synthesise, amplify the nets whose forces fail" before giving up.
-MAX_AMPLIFY_ROUNDS = 3
+MAX_AMPLIFY_ROUNDS = 6  # a deep chain is relieved one level of amplifiers a round
 
 
 def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
@@ -194,7 +264,7 @@ def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
         mech = assemble_mechanism(nl, layout, lib, opts.mech)
         if not opts.amplify or attempt == MAX_AMPLIFY_ROUNDS:
             break
-        short = nets_short_of_force(nl, mech, lib)
+        short = nets_short_of_force(nl, mech, lib) or nets_overstressed(nl, mech)
         if not short:
             break
         amps.update(short)

@@ -22,7 +22,9 @@ def test_documented_cell_compiles_and_proves(cli, tmp_path):
     rc, _, err = cli("compile", sorter, "--cells", cells, "-o", design)
     assert rc == 0, err
     d = json.loads(design.read_text())
-    assert [c["cell"] for c in d["cells"] if c["type"] == "OR"] == ["wide_or"]
+    # every OR of the design is the user's cell (one in two levels; multi-level may use more)
+    ors = [c["cell"] for c in d["cells"] if c["type"] == "OR"]
+    assert ors and set(ors) == {"wide_or"}
     for level in ("kinematic", "dynamic"):
         rc, out, _ = cli("simulate", design, "--cells", cells, "--level", level, "--cases", "4")
         assert rc == 0, out

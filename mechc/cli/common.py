@@ -47,6 +47,11 @@ def compile_options(c: argparse.ArgumentParser) -> None:
                    default="conventional",
                    help="threshold: outputs of up to 3 inputs as THRESHOLD generators (001 Ch. "
                    "III); auto: only where that costs fewer parts (default: %(default)s)")
+    g.add_argument("--levels", choices=["2", "multi", "auto"], default="auto",
+                   help="2: sums of products; multi: multi-level logic (Yosys/ABC, mapped to "
+                   "the cells by parts; a BLIF or Verilog network is kept as its author wrote "
+                   "it); auto: build both and keep the one with fewer parts (default: "
+                   "%(default)s)")
     g.add_argument("--no-share", action="store_true",
                    help="do not share product terms between outputs")
     g.add_argument("--keep-hazards", action="store_true",
@@ -99,6 +104,7 @@ def options_from_args(args: argparse.Namespace) -> CompileOptions:
         cell_dirs=tuple(args.cell_dirs),
         amplify=not getattr(args, "no_amplify", False),
         timings=getattr(args, "timings", False),
+        levels=getattr(args, "levels", "2"),
     )
 
 

@@ -271,6 +271,8 @@ def details(design: Design, args: argparse.Namespace) -> list[str]:
             lines.append(f"essential hazard: state {h['state']}, {h['input']} {h['from']} -> "
                          f"{h['to']}: {h['requires']}")
         lines += ordering_lines(st.get("sequential", {}).get("ordering"))
+    if st.get("levels"):
+        lines.append(levels_line(st["levels"]))
     if "planes" in st:
         lines.append(f"interconnect: {st['rods']} rods, {st['rod_length_mm']:g} mm of rod, "
                      f"{st['bends']} bends, {st['planes']['count']} planes "
@@ -283,6 +285,24 @@ def details(design: Design, args: argparse.Namespace) -> list[str]:
         lines.append(f"... and {len(amps) - SHORT_OUTPUTS} more amplified nets "
                      "(stats.amplified in the design file)")
     return lines
+
+
+def levels_line(lv: dict) -> str:
+    """Which logic depth was built and what each cost: 'levels: multi-level chosen (476 parts;
+    two-level 1876)'; a two-level design not assembled shows its lower bound, '>= 1210'."""
+    names = {"2": "two-level", "multi": "multi-level"}
+    bound = ">= " if lv.get("two_level", "assembled") != "assembled" else ""
+    others = "; ".join(f"{names[k]} {bound if k == '2' else ''}{v}"
+                       for k, v in lv["parts"].items() if k != lv["chosen"])
+    line = (f"levels: {names[lv['chosen']]} {'chosen' if lv['asked'] == 'auto' else 'asked'} "
+            f"({lv['parts'][lv['chosen']]} parts{'; ' + others if others else ''})")
+    multi = lv.get("multi", {})
+    if lv["chosen"] == "multi" and multi.get("two_level_outputs"):
+        line += ("; built two-level for a static hazard: "
+                 + ", ".join(multi["two_level_outputs"]))
+    if multi.get("failed"):
+        line += f"; multi-level failed: {multi['failed']}"
+    return line
 
 
 def plane_list(used: list[int]) -> str:

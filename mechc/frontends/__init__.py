@@ -12,6 +12,7 @@ from mechc.frontends.boolfile import parse_bool_file
 from mechc.frontends.fsm import parse_fsm_file
 from mechc.frontends.kiss2 import parse_kiss_file
 from mechc.frontends.pla import parse_pla_file
+from mechc.frontends.verilog import parse_verilog_file
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import OutputSpec, Spec
 
@@ -25,6 +26,7 @@ FRONT_ENDS: dict[str, Callable[[str], Spec | SeqSpec]] = {
     ".fsm": parse_fsm_file,
     ".kiss2": parse_kiss_file,
     ".kiss": parse_kiss_file,
+    ".v": parse_verilog_file,
 }
 SPEC_SUFFIXES = tuple(FRONT_ENDS)
 

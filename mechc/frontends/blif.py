@@ -59,7 +59,22 @@ def parse_blif(text: str, path: str = "<string>") -> Spec:
     for o in outputs:
         funcs[o.text] = OutputSpec(o.text, on=table_cover(tables[o.text], len(inputs)),
                                    line=nodes[o.text].out.line)
-    return Spec(path, "pla", [w.text for w in inputs], [w.text for w in outputs], funcs)
+    return Spec(path, "pla", [w.text for w in inputs], [w.text for w in outputs], funcs,
+                structure=network_blif(inputs, outputs, nodes, order))
+
+
+def network_blif(inputs: list[Word], outputs: list[Word], nodes: dict[str, Node],
+                 order: list[str]) -> str:
+    """The network as clean BLIF (model ``top``, one line per cube, no comments or
+    continuations, nodes in evaluation order): what multi-level synthesis starts from, so the
+    structure the author gave is kept rather than flattened to a table."""
+    lines = [".model top", ".inputs " + " ".join(w.text for w in inputs),
+             ".outputs " + " ".join(w.text for w in outputs)]
+    for name in order:
+        nd = nodes[name]
+        lines.append(".names " + " ".join([f.text for f in nd.fanins] + [name]))
+        lines += [f"{c} {nd.phase}".strip() for c in nd.cubes]
+    return "\n".join(lines + [".end"]) + "\n"
 
 
 def logical_lines(text: str) -> list[list[Word]]:

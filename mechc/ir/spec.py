@@ -37,6 +37,9 @@ class Spec:
     # safe identifier -> the name as the source file wrote it, where the two differ (PLA
     # names such as ``di<11>``); for display only
     display: dict[str, str] = field(default_factory=dict)
+    # a structural network the author gave (BLIF, Verilog) as clean BLIF text, model ``top``,
+    # kept for multi-level synthesis; empty for specs given as functions
+    structure: str = field(default="", repr=False, compare=False)
     _tables: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
     @property

@@ -26,6 +26,7 @@ import networkx as nx
 from mechc.cells.library import Library
 from mechc.errors import DesignError
 from mechc.ir.netlist import CellInst, Netlist
+from mechc.passes.strength import strength_checks
 
 #: Used when the library's AMPLIFIER does not state how many loads it may drive.
 DEFAULT_FANOUT = 2
@@ -135,6 +136,39 @@ def nets_short_of_force(nl: Netlist, mech, lib: Library) -> dict[str, str]:
             net = c.where[len("input "):]
             if net in direct:
                 out[net] = f"force: the actuator of {net} would need {1 / c.value:.3g}x its rating"
+    return out
+
+
+def nets_overstressed(nl: Netlist, mech) -> dict[str, str]:
+    """Nets to amplify where a part is too weak for what it must move, which is how a deep
+    (multi-level) chain fails: each cell asks its driver for more force than it delivers, so
+    the demand grows back along the chain. A cell that fails a strength check has its output
+    net's loads put behind amplifiers (it then moves only their light inputs); an AMPLIFIER
+    that fails has the output nets of the cells it drives amplified, which lowers what those
+    cells ask of it."""
+    failed = [c for c in strength_checks(mech) if not c.passed]
+    loads: dict[str, list[CellInst]] = {}
+    for c in nl.cells.values():
+        for net in c.inputs:
+            loads.setdefault(net, []).append(c)
+
+    def amplifiable(net: str) -> bool:  # loads that are not amplifiers already
+        return any(c.type != "AMPLIFIER" for c in loads.get(net, ()))
+
+    out: dict[str, str] = {}
+    for chk in failed:
+        owner = nl.cells.get(chk.where.split(".")[0])
+        if owner is None:
+            continue
+        why = f"force: {chk.name} of {owner.id} ({owner.type}) over its limit"
+        if owner.type != "AMPLIFIER":
+            targets = list(owner.outputs)
+        else:
+            targets = [n for c in loads.get(owner.outputs[0], ()) if c.type != "AMPLIFIER"
+                       for n in c.outputs]
+        for net in targets:
+            if amplifiable(net) and net not in out and net not in nl.state_nets():
+                out[net] = why
     return out
 
 
