@@ -212,6 +212,20 @@ def test_a_heavy_load_fails_the_strength_checks_and_reloads(cli, tmp_path):
     assert rc == 0, err
 
 
+@pytest.mark.parametrize("name", ["heavy.json", "heavy.json.gz"])
+def test_a_design_the_checks_reject_never_replaces_an_existing_file(cli, tmp_path, name):
+    """The user's earlier design at -o stays as it was; the rejected one goes beside it."""
+    out = tmp_path / name
+    out.write_bytes(b"the user's earlier design")
+    rc, _, err = cli("compile", SORTER, "-o", out, "--output-load", "3000")
+    assert rc == 1 and "DESIGN CHECKS FAILED" in err
+    assert out.read_bytes() == b"the user's earlier design"
+    beside = tmp_path / name.replace(".json", ".rejected.json")
+    assert f"written to {beside}" in err and f"{out} is unchanged" in err
+    rc, _, err = cli("simulate", beside, "--level", "logic")
+    assert rc == 0, err
+
+
 def test_unknown_material_lists_the_known_ones(cli, tmp_path):
     rc, _, err = cli("compile", SORTER, "-o", tmp_path / "x.json", "--material", "wood")
     assert rc == 2 and "'wood'" in err

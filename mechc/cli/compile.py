@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 from pathlib import Path
@@ -122,11 +123,13 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
         print(f"{out} was NOT written (an existing file there is unchanged): the design fails "
               "its own proof; --no-prove writes it for inspection", file=sys.stderr)
         return EXIT_FAILED
+    checks_failed = bool(dc) and not dc["passed"]
+    written = rejected_path(out) if checks_failed and os.path.exists(out) else out
     stages.start("write")
     t0 = time.perf_counter()
-    write_atomic(out, design_bytes(text, out))
+    write_atomic(written, design_bytes(text, written))
     stages.end("write", time.perf_counter() - t0)
-    print(f"{args.spec} -> {out}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
+    print(f"{args.spec} -> {written}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
           f"{st['parts']} parts, {st['literals']} literals, {minimality(st)}, "
           f"{stages.total():.2f} s")
     if not args.quiet:
@@ -134,8 +137,9 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
             print(f"  {line}")
         if args.print_netlist:
             print(design.netlist.to_text(), end="")
-    if dc and not dc["passed"]:
-        check_failures(dc, f"the design was written to {out} for inspection")
+    if checks_failed:
+        kept = f" ({out} is unchanged)" if written != out else ""
+        check_failures(dc, f"the design was written to {written} for inspection{kept}")
         for r in proofs:
             print(f"  {r['text']}")
         return EXIT_FAILED
@@ -150,6 +154,15 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
     if summary and not args.quiet:
         print(summary, file=sys.stderr)
     return EXIT_OK if met else EXIT_FAILED
+
+
+def rejected_path(out: str) -> str:
+    """Where a design that fails its design checks goes when ``out`` already holds a file: next
+    to it, so the user's earlier design is never replaced by one the checks reject."""
+    for suffix in (".json.gz", ".json"):
+        if out.endswith(suffix):
+            return out[: -len(suffix)] + ".rejected" + suffix
+    return out + ".rejected"
 
 
 def check_failures(dc: dict, what: str) -> None:
