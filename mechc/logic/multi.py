@@ -29,10 +29,27 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 
-from mechc.logic.cover import coverage, solve_cover
+from mechc.logic.cover import coverage, solve_cover, unique_rows
 from mechc.logic.cubes import Cube
 from mechc.logic.espresso import ComplementTooLarge, complement, espresso, pack, unpack
+from mechc.logic.implicants import (
+    cover_matrix,
+    encode,
+    multi_output_primes,
+    raise_to_primes,
+    table_fits,
+)
 from mechc.logic.primes import TooManyPrimes, prime_implicants
+from mechc.logic.setcover import heuristic_cover
+
+#: More multi-output primes than this (or more cover-matrix entries than ``TABLE_MAX_NNZ``):
+#: the table engine gives way to espresso's loop.
+TABLE_MAX_PRIMES = 400_000
+TABLE_MAX_NNZ = 40_000_000
+#: The integer program runs on the whole (essential-reduced) covering problem up to this many
+#: cells (rows x columns); past it its dominance reduction alone took minutes (alu4: 26,572 x
+#: 6,900 took 170 s), so it runs on the columns of the heuristic covers only.
+EXACT_MAX_CELLS = 60_000_000
 
 _EMPTY3 = (np.zeros(0, dtype=np.int64),) * 3
 
@@ -258,8 +275,12 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
     t0 = time.perf_counter()
     deadline = t0 + time_limit
     m = on.shape[0]
-    sets = output_sets(region)
     limited: list[str] = []
+    if m <= 62 and table_fits(n, m):
+        res = _by_table(n, on, region, [start, *seeds], t0, deadline, limited, prime_limit)
+        if res is not None:
+            return res
+    sets = output_sets(region)
     if m <= 62:
         try:
             pm, pv, ps = multi_primes(sets, prime_limit, t0 + 0.3 * time_limit)
@@ -319,6 +340,119 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
         limited.append("multi-output cover of espresso's products")
     outs = max_outputs(cubes, sets, n)
     return _finish(cubes, outs, on, n, False, method, t0, deadline, limited)
+
+
+def _essentials(A) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Columns some row has as its only cover, repeatedly: (forced, rows left, columns left
+    that still cover a row)."""
+    A = A.tocsr()
+    rows = np.arange(A.shape[0])
+    cols = np.arange(A.shape[1])
+    forced: list[np.ndarray] = []
+    while len(rows):
+        sub = A[rows][:, cols].tocsr()
+        deg = np.diff(sub.indptr)
+        if (deg == 0).any():
+            raise ValueError("a row no candidate covers")
+        ess = np.unique(sub.indices[sub.indptr[:-1][deg == 1]])
+        live = np.asarray(sub.sum(axis=0)).ravel() > 0
+        if not len(ess):
+            cols = cols[live]
+            break
+        forced.append(cols[ess])
+        rows = rows[~(np.asarray(sub[:, ess].sum(axis=1)).ravel() > 0)]
+        live[ess] = False
+        cols = cols[live]
+    f = np.concatenate(forced) if forced else np.zeros(0, dtype=np.int64)
+    return np.sort(f), rows, cols
+
+
+def _start_columns(starts: list[list[list[Cube]]], pool: np.ndarray, T: np.ndarray,
+                   n: int) -> list[np.ndarray]:
+    """Each starting cover (a cube list per output) as pool columns: its cubes raised to
+    multi-output primes (those that cover no on-minterm are left out)."""
+    out = []
+    for cover in starts:
+        merged: dict[Cube, int] = {}
+        for i, cubes in enumerate(cover):
+            for c in cubes:
+                merged[c] = merged.get(c, 0) | (1 << i)
+        if not merged:
+            continue
+        cm = np.array([c.mask for c in merged], dtype=np.int64)
+        cv = np.array([c.value for c in merged], dtype=np.int64)
+        idx = raise_to_primes(cm, cv, np.array(list(merged.values()), dtype=np.int64), T, n)
+        pos = np.clip(np.searchsorted(pool, idx), 0, len(pool) - 1)
+        out.append(np.unique(pos[pool[pos] == idx]))
+    return out
+
+
+def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list[Cube]]],
+              t0: float, deadline: float, limited: list[str],
+              prime_limit: int) -> MultiCover | None:
+    """Every multi-output prime from the ternary table, then the covering program: exact
+    (HiGHS) when it is small enough, else row weighting local search from the greedy cover
+    and from the starting covers, and the integer program over the columns of those covers.
+    None when the primes or the matrix are too large (the caller uses espresso's loop). More
+    than ``prime_limit`` primes: no exact program on the whole problem."""
+    pm, pv, ps, T = multi_output_primes(region, n)
+    if len(pm) > TABLE_MAX_PRIMES:
+        return None
+    A = cover_matrix(pm, pv, ps, on, n).tocsc()
+    if A.nnz > TABLE_MAX_NNZ:
+        return None
+    useful = np.diff(A.indptr) > 0  # primes that cover an on-minterm of one of their outputs
+    pm, pv, ps = pm[useful], pv[useful], ps[useful]
+    A = unique_rows(A[:, useful].tocsr())
+    cost = _weights(pm, pv)
+    pool = encode(pm, pv, n)
+    forced, rows, cols = _essentials(A)
+    sub = A[rows][:, cols].tocsr()
+    c_sub = cost[cols]
+
+    def left() -> float:
+        return deadline - time.perf_counter()
+
+    def result(chosen: np.ndarray, proven: bool, method: str) -> MultiCover:
+        idx = np.union1d(forced, cols[chosen]).astype(np.int64)
+        cubes = [Cube(int(pm[k]), int(pv[k])) for k in idx]
+        return _finish(cubes, ps[idx], on, n, proven, method, t0, deadline, limited)
+
+    if sub.shape[0] == 0:
+        return result(np.zeros(0, dtype=np.int64), True, "exact")
+    # a first cover by local search: a bound for the integer program and a fallback
+    best = heuristic_cover(sub, c_sub, min(1.0, max(0.05, 0.1 * left())))
+    core: set[int] = set(best.tolist())
+    if len(pm) <= prime_limit and sub.shape[0] * sub.shape[1] <= EXACT_MAX_CELLS:
+        chosen, proven = solve_cover(sub, c_sub, n, max(0.1, 0.5 * left()))
+        if proven:
+            return result(chosen, True, "exact")
+        limited.append("exact multi-output cover")
+        if _better(chosen, best, c_sub):
+            best = chosen
+    # local search from the starting covers and from the best cover so far
+    col_pos = np.full(A.shape[1], -1, dtype=np.int64)
+    col_pos[cols] = np.arange(len(cols))
+    begin = [col_pos[s][col_pos[s] >= 0] for s in _start_columns(starts, pool, T, n)]
+    begin.append(best)
+    share = max(0.05, 0.6 * left()) / len(begin)
+    for k, s in enumerate(begin):
+        got = heuristic_cover(sub, c_sub, share, start=s, seed=k + 1)
+        core.update(got.tolist())
+        if _better(got, best, c_sub):
+            best = got
+    # the integer program over the columns those covers use
+    core_cols = np.array(sorted(core), dtype=np.int64)
+    if left() > 0.2 and len(core_cols):
+        got, _ = solve_cover(sub[:, core_cols], c_sub[core_cols], n, max(0.1, 0.9 * left()))
+        got = core_cols[got]
+        if _better(got, best, c_sub):
+            best = got
+    return result(best, False, "multi-output primes+local search")
+
+
+def _better(a: np.ndarray, b: np.ndarray, cost: np.ndarray) -> bool:
+    return (len(a), int(cost[a].sum())) < (len(b), int(cost[b].sum()))
 
 
 def _pair_primes(cand: dict, on: np.ndarray, region: np.ndarray, limit: int,
