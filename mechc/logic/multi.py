@@ -424,7 +424,7 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
     if sub.shape[0] == 0:
         return result(np.zeros(0, dtype=np.int64), True, "exact")
     # a first cover by local search: a bound for the integer program and a fallback
-    best = heuristic_cover(sub, c_sub, max(0.05, 0.1 * left()), max_steps=LOCAL_STEPS // 4)
+    best = heuristic_cover(sub, c_sub, max(0.05, 0.1 * left()), max_steps=LOCAL_STEPS // 8)
     core: set[int] = set(best.tolist())
     if len(pm) <= prime_limit:
         chosen, proven = _program(sub, c_sub, n, 0.5 * left(), best)
@@ -433,21 +433,22 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
         limited.append("exact multi-output cover")
         if _better(chosen, best, c_sub):
             best = chosen
-    # local search from the starting covers and from the best cover so far
+    # local search from the best of the starting covers (made irredundant) and the cover so far
     col_pos = np.full(A.shape[1], -1, dtype=np.int64)
     col_pos[cols] = np.arange(len(cols))
-    begin = [col_pos[s][col_pos[s] >= 0] for s in _start_columns(starts, pool, T, n)]
-    begin.append(best)
-    steps = LOCAL_STEPS // len(begin)
-    for k, s in enumerate(begin):
-        share = max(0.05, 0.6 * left() / (len(begin) - k))
-        t_ls = time.perf_counter()
-        got = heuristic_cover(sub, c_sub, share, start=s, seed=k + 1, max_steps=steps)
-        if time.perf_counter() - t_ls >= share and "local search" not in limited:
-            limited.append("local search")
+    for s in _start_columns(starts, pool, T, n):
+        got = heuristic_cover(sub, c_sub, 0.0, start=col_pos[s][col_pos[s] >= 0])
         core.update(got.tolist())
         if _better(got, best, c_sub):
             best = got
+    share = max(0.05, 0.7 * left())
+    t_ls = time.perf_counter()
+    got = heuristic_cover(sub, c_sub, share, start=best, seed=1, max_steps=LOCAL_STEPS)
+    if time.perf_counter() - t_ls >= share:
+        limited.append("local search")
+    core.update(got.tolist())
+    if _better(got, best, c_sub):
+        best = got
     # the integer program over the columns those covers use
     core_cols = np.array(sorted(core), dtype=np.int64)
     if left() > 0.2 and len(core_cols):

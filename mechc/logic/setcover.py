@@ -27,6 +27,12 @@ from scipy import sparse
 
 def _gather(indptr: np.ndarray, indices: np.ndarray, which: np.ndarray) -> np.ndarray:
     """The concatenated index lists of the rows (or columns) ``which``."""
+    if len(which) <= 8:  # the common case in the local search: a few slices
+        if len(which) == 1:
+            w = int(which[0])
+            return indices[indptr[w]:indptr[w + 1]]
+        return np.concatenate([indices[indptr[w]:indptr[w + 1]] for w in which.tolist()]) \
+            if len(which) else np.zeros(0, dtype=indices.dtype)
     starts = indptr[which]
     lens = indptr[which + 1] - starts
     total = int(lens.sum())
@@ -136,7 +142,7 @@ def _row_weighting(S: _Cover, chosen: np.ndarray, cov: np.ndarray, t_end: float,
     # scores from scratch: chosen columns lose the rows only they cover
     once = np.flatnonzero(cov == 1)
     cols = _gather(cp, ci, once)
-    rep = np.repeat(once, np.diff(cp)[once])
+    rep = np.repeat(once, np.diff(cp)[once])  # each row once per column it has
     sel = chosen[cols]
     np.subtract.at(score, cols[sel], w[rep[sel]])
     stamp = np.zeros(S.nc, dtype=np.int64)
@@ -146,9 +152,11 @@ def _row_weighting(S: _Cover, chosen: np.ndarray, cov: np.ndarray, t_end: float,
     n_open = 0
     step = 0
 
+    rdeg = np.diff(cp)
+
     def rows_with_cols(rows: np.ndarray):
         c = _gather(cp, ci, rows)
-        return c, np.repeat(rows, np.diff(cp)[rows])
+        return c, np.repeat(rows, rdeg[rows])
 
     def add(j: int) -> int:
         rows = ri[rp[j]:rp[j + 1]]
