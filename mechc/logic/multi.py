@@ -53,6 +53,9 @@ EXACT_MAX_CELLS = 60_000_000
 #: Steps of row weighting local search, shared by its starts (20,000 steps took ex1010 from
 #: 287 products (greedy) to 270, in 5 s of one core).
 LOCAL_STEPS = 24_000
+#: Each output's OR inputs are chosen exactly among up to this many products, greedily beyond
+#: (the exact program's greedy start alone took 12 s for 1,900 products over 2**16 rows).
+PICK_EXACT_COLUMNS = 400
 
 _EMPTY3 = (np.zeros(0, dtype=np.int64),) * 3
 
@@ -406,7 +409,8 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
         return None
     useful = np.diff(A.indptr) > 0  # primes that cover an on-minterm of one of their outputs
     pm, pv, ps = pm[useful], pv[useful], ps[useful]
-    A = unique_rows(A[:, useful].tocsr())
+    full = A[:, useful].tocsr()  # rows output-major: output i's on-minterms in a block
+    A = unique_rows(full)
     cost = _weights(pm, pv)
     pool = encode(pm, pv, n)
     forced, rows, cols = _essentials(A)
@@ -419,7 +423,25 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
     def result(chosen: np.ndarray, proven: bool, method: str) -> MultiCover:
         idx = np.union1d(forced, cols[chosen]).astype(np.int64)
         cubes = [Cube(int(pm[k]), int(pv[k])) for k in idx]
-        return _finish(cubes, ps[idx], on, n, proven, method, t0, deadline, limited)
+        blocks = np.concatenate([[0], np.cumsum(on.sum(axis=1))])
+        use = []
+        for i in range(on.shape[0]):  # each output: the fewest chosen products covering it
+            mine = idx[(ps[idx] >> i) & 1 == 1]
+            Ai = full[blocks[i]:blocks[i + 1]][:, mine]
+            if Ai.shape[0] == 0:
+                use.append([])
+                continue
+            if len(mine) <= PICK_EXACT_COLUMNS:
+                got, done = solve_cover(Ai, cost[mine], n, max(0.05, left() / on.shape[0]))
+                if not done and "OR inputs per output" not in limited:
+                    limited.append("OR inputs per output")
+            else:
+                got = heuristic_cover(Ai, cost[mine], 0.0)
+            use.append(np.searchsorted(idx, mine[got]).tolist())
+        used = sorted({k for u in use for k in u})
+        remap = {k: j for j, k in enumerate(used)}
+        return MultiCover([cubes[k] for k in used], [sorted(remap[k] for k in u) for u in use],
+                          proven, method, time.perf_counter() - t0, limited)
 
     if sub.shape[0] == 0:
         return result(np.zeros(0, dtype=np.int64), True, "exact")
