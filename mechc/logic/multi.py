@@ -53,6 +53,9 @@ EXACT_MAX_CELLS = 60_000_000
 #: Steps of row weighting local search, shared by its starts (20,000 steps took ex1010 from
 #: 287 products (greedy) to 270, in 5 s of one core).
 LOCAL_STEPS = 24_000
+#: Steps it takes even past the time limit (ex1010: 287 -> 277 products in 5,000 steps, about
+#: 1.5 s of one core), so the result does not hang on how busy the machine is.
+LOCAL_MIN_STEPS = 6_000
 #: Each output's OR inputs are chosen exactly among up to this many products, greedily beyond
 #: (the exact program's greedy start alone took 12 s for 1,900 products over 2**16 rows).
 PICK_EXACT_COLUMNS = 400
@@ -465,7 +468,8 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
             best = got
     share = max(0.05, 0.7 * left())
     t_ls = time.perf_counter()
-    got = heuristic_cover(sub, c_sub, share, start=best, seed=1, max_steps=LOCAL_STEPS)
+    got = heuristic_cover(sub, c_sub, share, start=best, seed=1, max_steps=LOCAL_STEPS,
+                          min_steps=LOCAL_MIN_STEPS)
     if time.perf_counter() - t_ls >= share:
         limited.append("local search")
     core.update(got.tolist())

@@ -106,10 +106,12 @@ class _Cover:
 
 def heuristic_cover(A: sparse.csr_matrix, cost: np.ndarray, time_limit: float,
                     start: np.ndarray | None = None, seed: int = 0,
-                    max_steps: int | None = None) -> np.ndarray:
+                    max_steps: int | None = None, min_steps: int = 0) -> np.ndarray:
     """Column indices of a cover of every row of ``A`` with few columns (then little
     ``cost``): greedy (or ``start``, column indices of a cover), redundancy removal, then row
-    weighting local search until ``time_limit`` (or ``max_steps`` steps)."""
+    weighting local search until ``time_limit`` (or ``max_steps`` steps), but at least
+    ``min_steps`` steps when the time limit is positive (a result that does not depend on
+    how busy the machine is)."""
     t_end = time.perf_counter() + time_limit
     S = _Cover(A, cost)
     if S.nr == 0:
@@ -124,11 +126,13 @@ def heuristic_cover(A: sparse.csr_matrix, cost: np.ndarray, time_limit: float,
     S.prune(chosen, cov, None)
     if time_limit <= 0 or chosen.sum() <= 1:
         return np.flatnonzero(chosen)
-    return _row_weighting(S, chosen, cov, t_end, np.random.default_rng(seed), max_steps)
+    return _row_weighting(S, chosen, cov, t_end, np.random.default_rng(seed), max_steps,
+                          min_steps)
 
 
 def _row_weighting(S: _Cover, chosen: np.ndarray, cov: np.ndarray, t_end: float,
-                   rng: np.random.Generator, max_steps: int | None) -> np.ndarray:
+                   rng: np.random.Generator, max_steps: int | None,
+                   min_steps: int = 0) -> np.ndarray:
     """Row weighting local search for unate covering (after Gao et al., 2015): with k columns
     covering everything, drop one and look for a cover of k - 1 by swapping columns; rows left
     open gain weight, so the search is pushed towards covering the hard ones. A column's
@@ -203,7 +207,8 @@ def _row_weighting(S: _Cover, chosen: np.ndarray, cov: np.ndarray, t_end: float,
         return int(top[np.argmin(stamp[top])])
 
     last = -1
-    while time.perf_counter() < t_end and (max_steps is None or step < max_steps):
+    while ((step < min_steps or time.perf_counter() < t_end)
+           and (max_steps is None or step < max_steps)):
         step += 1
         while n_open == 0:
             val = S.value(chosen)
