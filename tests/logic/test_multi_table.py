@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from scipy import sparse
 
+from mechc.logic.cubes import Cube
 from mechc.logic.implicants import (
     cover_matrix,
     cube_points,
@@ -147,3 +148,19 @@ def test_table_engine_heuristic_route_is_right_on_every_vector(seed):
             assert region[i][inside].all()
             got |= inside
         assert (got | ~on[i]).all()
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_table_engine_never_more_products_than_its_start(seed):
+    """Started from per-output covers (each output's minterms), the heuristic route keeps at
+    most as many distinct products as the start has (the start, raised to primes and made
+    irredundant, is one of the covers it compares)."""
+    rng = np.random.default_rng(600 + seed)
+    n, m = 6, 3
+    _tables, on, region = _regions(rng, n, m)
+    full = (1 << n) - 1
+    start = [[Cube(full, int(x)) for x in np.flatnonzero(on[i])] for i in range(m)]
+    distinct = len({c for cover in start for c in cover})
+    res = minimise_multi(n, on, region, start, time_limit=0.5, prime_limit=1)
+    assert res.products <= distinct
+    assert sum(len(u) for u in res.use) >= res.products  # every product feeds an output
