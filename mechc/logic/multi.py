@@ -56,6 +56,9 @@ LOCAL_STEPS = 24_000
 #: Steps it takes even past the time limit (ex1010: 287 -> 277 products in 5,000 steps, about
 #: 1.5 s of one core), so the result does not hang on how busy the machine is.
 LOCAL_MIN_STEPS = 6_000
+#: ... scaled down on problems with more matrix entries than this (a step's cost grows with
+#: them: on b12, 1.6 million entries, 6,000 steps took 10 s).
+LOCAL_MIN_NNZ = 200_000
 #: Each output's OR inputs are chosen exactly among up to this many products, greedily beyond
 #: (the exact program's greedy start alone took 12 s for 1,900 products over 2**16 rows).
 PICK_EXACT_COLUMNS = 400
@@ -468,8 +471,9 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
             best = got
     share = max(0.05, 0.7 * left())
     t_ls = time.perf_counter()
+    floor = int(LOCAL_MIN_STEPS * min(1.0, LOCAL_MIN_NNZ / max(1, sub.nnz)))
     got = heuristic_cover(sub, c_sub, share, start=best, seed=1, max_steps=LOCAL_STEPS,
-                          min_steps=LOCAL_MIN_STEPS)
+                          min_steps=floor)
     if time.perf_counter() - t_ls >= share:
         limited.append("local search")
     core.update(got.tolist())
