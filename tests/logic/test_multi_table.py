@@ -164,3 +164,26 @@ def test_table_engine_never_more_products_than_its_start(seed):
     res = minimise_multi(n, on, region, start, time_limit=0.5, prime_limit=1)
     assert res.products <= distinct
     assert sum(len(u) for u in res.use) >= res.products  # every product feeds an output
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_wide_fallback_without_the_table_is_right_on_every_vector(seed, monkeypatch):
+    """Where the table would be too large the minimiser falls back to the Shannon primes and
+    espresso's loop; that route too gives covers right on every care vector."""
+    import mechc.logic.multi as multi
+
+    monkeypatch.setattr(multi, "table_fits", lambda n, m: False)
+    rng = np.random.default_rng(800 + seed)
+    n, m = 6, 3
+    _tables, on, region = _regions(rng, n, m)
+    full = (1 << n) - 1
+    start = [[Cube(full, int(x)) for x in np.flatnonzero(on[i])] for i in range(m)]
+    res = minimise_multi(n, on, region, start, time_limit=2.0, prime_limit=1)
+    idx = np.arange(1 << n)
+    for i in range(m):
+        got = np.zeros(1 << n, dtype=bool)
+        for c in res.output_cubes(i):
+            inside = (idx & c.mask) == c.value
+            assert region[i][inside].all()
+            got |= inside
+        assert (got | ~on[i]).all()
