@@ -410,6 +410,9 @@ def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list
     pm, pv, ps, T = multi_output_primes(region, n)
     if len(pm) > TABLE_MAX_PRIMES:
         return None
+    free = n - np.bitwise_count(pm.astype(np.uint64)).astype(np.int64)
+    if int(np.ldexp(1.0, free).sum()) > TABLE_MAX_NNZ:  # the (prime, minterm) pairs to list
+        return None
     A = cover_matrix(pm, pv, ps, on, n).tocsc()
     if A.nnz > TABLE_MAX_NNZ:
         return None
