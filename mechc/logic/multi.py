@@ -5,13 +5,16 @@ it, so the cost that matters is the number of *distinct* products (each one AND 
 own fan-out), then their literals, then the OR inputs. Per-output minimum covers shared
 afterwards miss this: on the MCNC PLAs they had up to 2.4 times espresso's product count.
 
-Two engines, both on truth tables (n <= MAX_TABLE_INPUTS):
+Engines, all on truth tables (n <= MAX_TABLE_INPUTS):
 
-* exact: the multi-output primes — maximal pairs (cube c, output set S) with c inside every
-  region of S (``multi_primes``, Shannon recursion with output sets as bit masks) — then a
-  unate covering program with a row per (output, on-minterm) and a column per prime: fewest
-  columns, then the fewest parts the mapper spends on them (``product_parts``; HiGHS with a
-  time limit, ``cover.solve_cover``);
+* table (``_by_table``, when the ternary table of ``implicants.py`` fits): every multi-output
+  prime at once, a unate covering problem with a row per (output, on-minterm) and a column
+  per prime, solved exactly (HiGHS; fewest columns, then the fewest parts the mapper spends on
+  them, ``product_parts``) when it finishes in time, else by row weighting local search
+  (``setcover.py``) from the greedy cover and from the starting covers raised to primes, then
+  the program over the columns those covers use;
+* exact by recursion, for specs whose table is too large: the multi-output primes by Shannon
+  recursion with output sets as bit masks (``multi_primes``), then the same program;
 * heuristic: espresso's loop (``espresso.espresso``) on the characteristic function, each
   output a one-hot variable: a cube (c, S) is c · Π_{j∉S} ȳ_j, the points (x, e_i) carry output
   i's value and every point whose y is not one-hot is a don't-care. Its cover's products are
