@@ -94,9 +94,9 @@ def run(paths: list[Path]) -> list[dict]:
     out = []
     for path in paths:
         spec = parse_pla_file(path)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         eq = minimise(spec)
-        seconds = time.perf_counter() - t0
+        seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
         t1 = time.perf_counter()
         before = minimise(spec, MinimiseOptions(multi_output=False))
         before_seconds = time.perf_counter() - t1
@@ -104,14 +104,15 @@ def run(paths: list[Path]) -> list[dict]:
         parts_after, built = mapped(eq, lib)
         row = {"name": path.stem, "inputs": spec.n, "outputs": len(spec.outputs),
                "products": eq.products, "espresso": esp, "espresso_s": esp_s, "source": source,
-               "seconds": seconds, "proven": eq.proven, "limited": len(eq.time_limited),
+               "seconds": seconds, "cpu": cpu, "proven": eq.proven,
+               "limited": len(eq.time_limited),
                "before_products": before.products, "before_s": before_seconds,
                "parts_before": mapped(before, lib)[0], "parts_after": parts_after,
                "built_products": built}
         out.append(row)
         print(f"{row['name']:>10} {row['inputs']:>3} {row['outputs']:>3} "
               f"products {row['products']:>4} (espresso {esp}, before {row['before_products']})"
-              f" {seconds:6.2f} s{' proven' if eq.proven else ''}"
+              f" {seconds:6.2f} s (cpu {cpu:.2f} s){' proven' if eq.proven else ''}"
               f"{f' [{len(eq.time_limited)} time limits]' if eq.time_limited else ''}"
               f"  parts {row['parts_before']} -> {row['parts_after']} "
               f"(built with {built} products)", flush=True)
@@ -120,11 +121,12 @@ def run(paths: list[Path]) -> list[dict]:
 
 def markdown(rows: list[dict]) -> str:
     lines = ["| PLA | in | out | mechc products | espresso products | per-output products "
-             "| mechc s | proven | parts per-output | parts now | products built |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| mechc s | mechc cpu s | proven | parts per-output | parts now | products built |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         lines.append(f"| {r['name']} | {r['inputs']} | {r['outputs']} | {r['products']} | "
                      f"{r['espresso']} | {r['before_products']} | {r['seconds']:.1f} | "
+                     f"{r['cpu']:.1f} | "
                      f"{'yes' if r['proven'] else 'no'} | {r['parts_before']} | "
                      f"{r['parts_after']} | {r['built_products']} |")
     sources = sorted({r["source"] for r in rows})

@@ -5,13 +5,16 @@ it, so the cost that matters is the number of *distinct* products (each one AND 
 own fan-out), then their literals, then the OR inputs. Per-output minimum covers shared
 afterwards miss this: on the MCNC PLAs they had up to 2.4 times espresso's product count.
 
-Two engines, both on truth tables (n <= MAX_TABLE_INPUTS):
+Engines, all on truth tables (n <= MAX_TABLE_INPUTS):
 
-* exact: the multi-output primes — maximal pairs (cube c, output set S) with c inside every
-  region of S (``multi_primes``, Shannon recursion with output sets as bit masks) — then a
-  unate covering program with a row per (output, on-minterm) and a column per prime: fewest
-  columns, then the fewest parts the mapper spends on them (``product_parts``; HiGHS with a
-  time limit, ``cover.solve_cover``);
+* table (``_by_table``, when the ternary table of ``implicants.py`` fits): every multi-output
+  prime at once, a unate covering problem with a row per (output, on-minterm) and a column
+  per prime, solved exactly (HiGHS; fewest columns, then the fewest parts the mapper spends on
+  them, ``product_parts``) when it finishes in time, else by row weighting local search
+  (``setcover.py``) from the greedy cover and from the starting covers raised to primes, then
+  the program over the columns those covers use;
+* exact by recursion, for specs whose table is too large: the multi-output primes by Shannon
+  recursion with output sets as bit masks (``multi_primes``), then the same program;
 * heuristic: espresso's loop (``espresso.espresso``) on the characteristic function, each
   output a one-hot variable: a cube (c, S) is c · Π_{j∉S} ȳ_j, the points (x, e_i) carry output
   i's value and every point whose y is not one-hot is a don't-care. Its cover's products are
@@ -29,10 +32,39 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import sparse
 
-from mechc.logic.cover import coverage, solve_cover
+from mechc.logic.cover import _terms_then_cost, coverage, solve_cover, unique_rows
 from mechc.logic.cubes import Cube
 from mechc.logic.espresso import ComplementTooLarge, complement, espresso, pack, unpack
+from mechc.logic.implicants import (
+    cover_matrix,
+    encode,
+    multi_output_primes,
+    raise_to_primes,
+    table_fits,
+)
 from mechc.logic.primes import TooManyPrimes, prime_implicants
+from mechc.logic.setcover import heuristic_cover
+
+#: More multi-output primes than this (or more cover-matrix entries than ``TABLE_MAX_NNZ``):
+#: the table engine gives way to espresso's loop.
+TABLE_MAX_PRIMES = 400_000
+TABLE_MAX_NNZ = 40_000_000
+#: The integer program runs on the whole (essential-reduced) covering problem up to this many
+#: cells (rows x columns); past it its dominance reduction alone took minutes (alu4: 26,572 x
+#: 6,900 took 170 s), so it runs on the columns of the heuristic covers only.
+EXACT_MAX_CELLS = 60_000_000
+#: Steps of row weighting local search, shared by its starts (20,000 steps took ex1010 from
+#: 287 products (greedy) to 270, in 5 s of one core).
+LOCAL_STEPS = 24_000
+#: Steps it takes even past the time limit (ex1010: 287 -> 277 products in 5,000 steps, about
+#: 1.5 s of one core), so the result does not hang on how busy the machine is.
+LOCAL_MIN_STEPS = 6_000
+#: ... scaled down on problems with more matrix entries than this (a step's cost grows with
+#: them: on b12, 1.6 million entries, 6,000 steps took 10 s).
+LOCAL_MIN_NNZ = 200_000
+#: Each output's OR inputs are chosen exactly among up to this many products, greedily beyond
+#: (the exact program's greedy start alone took 12 s for 1,900 products over 2**16 rows).
+PICK_EXACT_COLUMNS = 400
 
 _EMPTY3 = (np.zeros(0, dtype=np.int64),) * 3
 
@@ -258,8 +290,12 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
     t0 = time.perf_counter()
     deadline = t0 + time_limit
     m = on.shape[0]
-    sets = output_sets(region)
     limited: list[str] = []
+    if m <= 62 and table_fits(n, m):
+        res = _by_table(n, on, region, [start, *seeds], t0, deadline, limited, prime_limit)
+        if res is not None:
+            return res
+    sets = output_sets(region)
     if m <= 62:
         try:
             pm, pv, ps = multi_primes(sets, prime_limit, t0 + 0.3 * time_limit)
@@ -319,6 +355,168 @@ def minimise_multi(n: int, on: np.ndarray, region: np.ndarray, start: list[list[
         limited.append("multi-output cover of espresso's products")
     outs = max_outputs(cubes, sets, n)
     return _finish(cubes, outs, on, n, False, method, t0, deadline, limited)
+
+
+def _essentials(A) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Columns some row has as its only cover, repeatedly: (forced, rows left, columns left
+    that still cover a row)."""
+    A = A.tocsr()
+    rows = np.arange(A.shape[0])
+    cols = np.arange(A.shape[1])
+    forced: list[np.ndarray] = []
+    while len(rows):
+        sub = A[rows][:, cols].tocsr()
+        deg = np.diff(sub.indptr)
+        if (deg == 0).any():
+            raise ValueError("a row no candidate covers")
+        ess = np.unique(sub.indices[sub.indptr[:-1][deg == 1]])
+        live = np.asarray(sub.sum(axis=0)).ravel() > 0
+        if not len(ess):
+            cols = cols[live]
+            break
+        forced.append(cols[ess])
+        rows = rows[~(np.asarray(sub[:, ess].sum(axis=1)).ravel() > 0)]
+        live[ess] = False
+        cols = cols[live]
+    f = np.concatenate(forced) if forced else np.zeros(0, dtype=np.int64)
+    return np.sort(f), rows, cols
+
+
+def _start_columns(starts: list[list[list[Cube]]], pool: np.ndarray, T: np.ndarray,
+                   n: int) -> list[np.ndarray]:
+    """Each starting cover (a cube list per output) as pool columns: its cubes raised to
+    multi-output primes (those that cover no on-minterm are left out)."""
+    out = []
+    for cover in starts:
+        merged: dict[Cube, int] = {}
+        for i, cubes in enumerate(cover):
+            for c in cubes:
+                merged[c] = merged.get(c, 0) | (1 << i)
+        if not merged:
+            continue
+        cm = np.array([c.mask for c in merged], dtype=np.int64)
+        cv = np.array([c.value for c in merged], dtype=np.int64)
+        idx = raise_to_primes(cm, cv, np.array(list(merged.values()), dtype=np.int64), T, n)
+        pos = np.clip(np.searchsorted(pool, idx), 0, len(pool) - 1)
+        out.append(np.unique(pos[pool[pos] == idx]))
+    return out
+
+
+def _by_table(n: int, on: np.ndarray, region: np.ndarray, starts: list[list[list[Cube]]],
+              t0: float, deadline: float, limited: list[str],
+              prime_limit: int) -> MultiCover | None:
+    """Every multi-output prime from the ternary table, then the covering program: exact
+    (HiGHS) when it is small enough, else row weighting local search from the greedy cover
+    and from the starting covers, and the integer program over the columns of those covers.
+    None when the primes or the matrix are too large (the caller uses espresso's loop). More
+    than ``prime_limit`` primes: no exact program on the whole problem."""
+    pm, pv, ps, T = multi_output_primes(region, n)
+    if len(pm) > TABLE_MAX_PRIMES:
+        return None
+    free = n - np.bitwise_count(pm.astype(np.uint64)).astype(np.int64)
+    if int(np.ldexp(1.0, free).sum()) > TABLE_MAX_NNZ:  # the (prime, minterm) pairs to list
+        return None
+    A = cover_matrix(pm, pv, ps, on, n).tocsc()
+    if A.nnz > TABLE_MAX_NNZ:
+        return None
+    useful = np.diff(A.indptr) > 0  # primes that cover an on-minterm of one of their outputs
+    pm, pv, ps = pm[useful], pv[useful], ps[useful]
+    full = A[:, useful].tocsr()  # rows output-major: output i's on-minterms in a block
+    A = unique_rows(full)
+    cost = _weights(pm, pv)
+    pool = encode(pm, pv, n)
+    forced, rows, cols = _essentials(A)
+    sub = A[rows][:, cols].tocsr()
+    c_sub = cost[cols]
+
+    def left() -> float:
+        return deadline - time.perf_counter()
+
+    def result(chosen: np.ndarray, proven: bool, method: str) -> MultiCover:
+        idx = np.union1d(forced, cols[chosen]).astype(np.int64)
+        cubes = [Cube(int(pm[k]), int(pv[k])) for k in idx]
+        blocks = np.concatenate([[0], np.cumsum(on.sum(axis=1))])
+        use = []
+        for i in range(on.shape[0]):  # each output: the fewest chosen products covering it
+            mine = idx[(ps[idx] >> i) & 1 == 1]
+            Ai = full[blocks[i]:blocks[i + 1]][:, mine]
+            if Ai.shape[0] == 0:
+                use.append([])
+                continue
+            if len(mine) <= PICK_EXACT_COLUMNS:
+                got, done = solve_cover(Ai, cost[mine], n, max(0.05, left() / on.shape[0]))
+                if not done and "OR inputs per output" not in limited:
+                    limited.append("OR inputs per output")
+            else:
+                got = heuristic_cover(Ai, cost[mine], 0.0)
+            use.append(np.searchsorted(idx, mine[got]).tolist())
+        used = sorted({k for u in use for k in u})
+        remap = {k: j for j, k in enumerate(used)}
+        return MultiCover([cubes[k] for k in used], [sorted(remap[k] for k in u) for u in use],
+                          proven, method, time.perf_counter() - t0, limited)
+
+    if sub.shape[0] == 0:
+        return result(np.zeros(0, dtype=np.int64), True, "exact")
+    # a first cover by local search: a bound for the integer program and a fallback
+    best = heuristic_cover(sub, c_sub, max(0.05, 0.1 * left()), max_steps=LOCAL_STEPS // 8)
+    core: set[int] = set(best.tolist())
+    if len(pm) <= prime_limit:
+        chosen, proven = _program(sub, c_sub, n, 0.5 * left(), best)
+        if proven:
+            return result(chosen, True, "exact")
+        limited.append("exact multi-output cover")
+        if _better(chosen, best, c_sub):
+            best = chosen
+    # local search from the best of the starting covers (made irredundant) and the cover so far
+    col_pos = np.full(A.shape[1], -1, dtype=np.int64)
+    col_pos[cols] = np.arange(len(cols))
+    for s in _start_columns(starts, pool, T, n):
+        got = heuristic_cover(sub, c_sub, 0.0, start=col_pos[s][col_pos[s] >= 0])
+        core.update(got.tolist())
+        if _better(got, best, c_sub):
+            best = got
+    share = max(0.05, 0.7 * left())
+    t_ls = time.perf_counter()
+    floor = int(LOCAL_MIN_STEPS * min(1.0, LOCAL_MIN_NNZ / max(1, sub.nnz)))
+    got = heuristic_cover(sub, c_sub, share, start=best, seed=1, max_steps=LOCAL_STEPS,
+                          min_steps=floor)
+    if time.perf_counter() - t_ls >= share:
+        limited.append("local search")
+    core.update(got.tolist())
+    if _better(got, best, c_sub):
+        best = got
+    # the integer program over the columns those covers use
+    core_cols = np.array(sorted(core), dtype=np.int64)
+    if left() > 0.2 and len(core_cols):
+        core_sub = sub[:, core_cols]
+        start = np.flatnonzero(np.isin(core_cols, best))
+        got, _ = _program(core_sub, c_sub[core_cols], n, 0.9 * left(), start)
+        got = core_cols[got]
+        if _better(got, best, c_sub):
+            best = got
+    return result(best, False, "multi-output primes+local search")
+
+
+def _program(A, cost: np.ndarray, n: int, seconds: float,
+             fallback: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The covering program (fewest columns, then least cost), ``fallback`` if it finds
+    nothing better. Small problems go through ``solve_cover``'s dominance reductions;
+    large ones straight to HiGHS, whose presolve does without the reductions' pairwise
+    products (alu4's 26,572 x 6,900 problem: proven in 1 s of CPU, against minutes)."""
+    seconds = max(0.1, seconds)
+    if A.shape[0] * A.shape[1] <= EXACT_MAX_CELLS:
+        return solve_cover(A, cost, n, seconds)
+    t_end = time.perf_counter() + seconds
+    picked, proven = _terms_then_cost(A, cost.astype(float),
+                                      lambda: max(0.05, t_end - time.perf_counter()),
+                                      len(fallback))
+    if picked is None:
+        return fallback, False
+    return np.flatnonzero(picked), proven
+
+
+def _better(a: np.ndarray, b: np.ndarray, cost: np.ndarray) -> bool:
+    return (len(a), int(cost[a].sum())) < (len(b), int(cost[b].sum()))
 
 
 def _pair_primes(cand: dict, on: np.ndarray, region: np.ndarray, limit: int,
