@@ -1,6 +1,6 @@
 """Parts of two-level against multi-level designs (docs/multilevel.md's table).
 
-    python benchmarks/multilevel_parts.py [examples/adder4.v ...]
+    python benchmarks/multilevel_parts.py [examples/multilevel/adder4.v ...]
 
 Each spec is compiled with ``--levels auto``: both designs are mapped, placed and assembled
 (amplifiers counted), and the stats give both part counts. Printed as a Markdown table with
@@ -17,7 +17,7 @@ from mechc.frontends import load_spec
 from mechc.pipeline import CompileOptions, compile_spec
 
 ROOT = Path(__file__).resolve().parent.parent
-DEFAULT = [f"examples/{n}.{f}" for n in ("adder4", "alu181", "cmp8") for f in ("v", "blif")]
+DEFAULT = [f"examples/multilevel/{n}.{f}" for n in ("adder4", "alu181", "cmp8") for f in ("v", "blif")]
 
 
 def row(path: str) -> str:

@@ -39,7 +39,7 @@ FORMATS = ["v", "blif"]
 
 @cache
 def compiled(name: str, fmt: str, levels: str = "auto") -> dict:
-    spec = load_spec(EXAMPLES / f"{name}.{fmt}")
+    spec = load_spec(EXAMPLES / "multilevel" / f"{name}.{fmt}")
     design = compile_spec(spec, CompileOptions(levels=levels))
     return json.loads(dumps_design(design_to_json(design)))
 
@@ -171,7 +171,7 @@ def test_kinematic_proof_passes(name, fmt):
 
 @cache
 def alu_mapped(fmt: str):
-    spec = load_spec(EXAMPLES / f"alu181.{fmt}")
+    spec = load_spec(EXAMPLES / "multilevel" / f"alu181.{fmt}")
     lib = load_library()
     eq = minimise(spec, MinimiseOptions())
     two = map_equations(eq, lib, MapOptions()).netlist

@@ -37,7 +37,7 @@ def test_mux_and_vector_ports():
 
 
 def test_adder_example_is_arithmetic():
-    spec = load_spec(EXAMPLES / "adder4.v")
+    spec = load_spec(EXAMPLES / "multilevel" / "adder4.v")
     for a, b, ci in itertools.product(range(16), range(16), (0, 1)):
         env = {f"A{i}": a >> i & 1 for i in range(4)} | {f"B{i}": b >> i & 1 for i in range(4)}
         env["CI"] = ci
