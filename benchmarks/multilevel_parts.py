@@ -17,7 +17,8 @@ from mechc.frontends import load_spec
 from mechc.pipeline import CompileOptions, compile_spec
 
 ROOT = Path(__file__).resolve().parent.parent
-DEFAULT = [f"examples/multilevel/{n}.{f}" for n in ("adder4", "alu181", "cmp8") for f in ("v", "blif")]
+DEFAULT = [f"examples/multilevel/{n}.{f}"
+           for n in ("adder4", "alu181", "cmp8") for f in ("v", "blif")]
 
 
 def row(path: str) -> str:
