@@ -151,3 +151,15 @@ def test_constant_state_variable_is_not_built():
             se.text(se.reset_names[se.memories[0]])) != ("0", "0")
     assert any("never set or reset" in w for w in se.warnings)
     assert prove_sequential(design.netlist, spec).passed
+
+
+def test_kiss2_unreachable_state_named_at_its_first_line():
+    from mechc.frontends.kiss2 import parse_kiss
+    text = (".i 1\n.o 1\n.s 3\n.r a\n0 a a 0\n1 a b 0\n1 b b 1\n0 b a 1\n"
+            "0 c c 1\n1 c c 0\n.e\n")  # nothing goes to c (line 9)
+    spec = parse_kiss(text, "m.kiss2")
+    design = compile_sequential(spec, mechanism=False)
+    gone = design.sequential.cover["unreachable_rows"]
+    assert gone and all(r.split("@")[0] == "c" for r in gone)
+    assert "(m.kiss2:9)" in design.sequential.warnings[0]
+    assert memories(design) == 0 and prove_sequential(design.netlist, spec).passed
