@@ -99,6 +99,8 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
         design, met = robust_design(args)
     else:
         design = compile_path(args.spec, args, stages=stages)
+    for w in getattr(getattr(design, "sequential", None), "warnings", None) or []:
+        print(f"warning: {w}", file=sys.stderr)
     stages.start("check file")
     t0 = time.perf_counter()
     text = dumps_design(design_to_json(design, timings=args.timings))
@@ -243,6 +245,7 @@ def proof_result(rep, dc: dict) -> dict:
     verdict = "proved" if rep.passed else "FAILED"
     text = (f"{rep.level} proof: {verdict}, {sampled_text(rep.cases, rep.coverage)}, "
             f"{rep.failure_count} failures, {rep.seconds:.2f} s")
+    text += rep.nothing_moved()
     if not rep.passed:
         text += "".join(f"\n  {failure_text(f)}" for f in rep.failures[:5])
     return {"text": text, "refuse": refuse}
@@ -338,8 +341,12 @@ def merged_rows_lines(design: Design) -> list[str]:
     rows = (f"{len(table.rows)} flow-table rows" if len(table.rows) != len(states) else "")
     merged = [c for c in classes if len(c) > 1]
     shown = ", ".join("+".join(c) for c in merged[:8]) + (" ..." if len(merged) > 8 else "")
+    gone = (getattr(se, "cover", None) or {}).get("unreachable_rows")
+    shown = "; ".join(p for p in (f"merged: {shown}" if merged else "",
+                                  f"unreachable, not built: {', '.join(gone)}" if gone else "")
+                      if p)
     return [f"flow table: {len(states)} states{f' ({rows})' if rows else ''} -> "
-            f"{len(classes)} row{'s' if len(classes) > 1 else ''} (merged: {shown})"]
+            f"{len(classes)} row{'s' if len(classes) > 1 else ''} ({shown})"]
 
 
 def cells_used(design: Design, lib: Library) -> list[str]:

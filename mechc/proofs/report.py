@@ -57,6 +57,14 @@ class ProofReport(Mapping):
     accuracy: dict | None = None
     source: dict = field(default_factory=dict)
 
+    def nothing_moved(self) -> str:
+        """A sequential proof that took no input change proves power-up only, and says so
+        where the verdict is read."""
+        if self.kind == "sequential" and (self.cases == 0 or
+                                          self.coverage.get("transitions") == 0):
+            return " (no input change to check: power-up state only)"
+        return ""
+
     def to_json(self) -> dict:
         lead = {k: v for k, v in self.coverage.items() if k in BEFORE_CASES}
         rest = {k: v for k, v in self.coverage.items() if k not in BEFORE_CASES}
@@ -104,7 +112,8 @@ class ProofReport(Mapping):
         # a sampled proof says so where the verdict is read, not only in --report
         cases = sampled_text(self.cases, self.coverage)
         lines.append(f"{verdict}: level {self.level}, {cases}, "
-                     f"{self.failure_count} failures{extra}, {self.seconds:.3f} s")
+                     f"{self.failure_count} failures{extra}, {self.seconds:.3f} s"
+                     + self.nothing_moved())
         lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
         if self.failure_count > SHOWN_FAILURES:
             lines.append(f"  ... and {self.failure_count - SHOWN_FAILURES} more (see --report)")

@@ -250,8 +250,10 @@ def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> ProofReport:
                         f"({' '.join(spec.inputs)} = {bits_text(x0, spec.n)}, {mem_text(q_init)})")
         return _report(spec, t0, failures, kinds, hazards, 0, 0, m)
     states = transitions = 0
+    reached: set = set()
     for (x, s, q), changes in _reachable(sn, spec, (x0, s0, st.finals[0])):
         states += 1
+        reached.add(s)
         vals = sn.eval(x, q)
         want = output_values(spec, s, x)
         for o, w in want.items():
@@ -282,7 +284,7 @@ def prove_sequential(nl: Netlist, spec: SeqSpec, seed: int = 0) -> ProofReport:
                                    f"{'hold' if hold else 'change once'})", output=o)
             _ternary(sn, spec, nl, x, x2, q, s, s2, before, after, where, fail, hazards,
                      res.finals[0] if res.finals else q)
-    return _report(spec, t0, failures, kinds, hazards, states, transitions, m)
+    return _report(spec, t0, failures, kinds, hazards, states, transitions, m, reached)
 
 
 def _reachable(sn: SeqNetlist, spec: SeqSpec, start: tuple):
@@ -383,15 +385,26 @@ def _group(hazards: list[dict]) -> list[dict]:
     return list(out.values())
 
 
-def _report(spec, t0, failures, kinds, hazards, states, transitions, m) -> ProofReport:
+def _report(spec, t0, failures, kinds, hazards, states, transitions, m,
+            reached: set | None = None) -> ProofReport:
     count = sum(kinds.values())
     hazards = _group(hazards)
+    scope: dict = {"scope": "every specified single-input change from every stable state "
+                            "reachable from power-up"}
+    if spec.table is not None and reached is not None:
+        rows = spec.table.rows
+        scope["rows_reached"] = len(reached)
+        scope["rows_never_stable"] = [rows[r] for r in range(len(rows)) if r not in reached]
+    if transitions == 0:
+        scope["note"] = ("no specified input change from power-up: only the power-up state "
+                         "was checked")
     return ProofReport(
         level="logic", kind="sequential", passed=count == 0, cases=states,
         coverage={"transitions": transitions, "exhaustive": True},
         failure_count=count, failure_kinds=dict(sorted(kinds.items())), failures=failures,
         figures={"sequential": {"form": spec.form, "stable_states": states,
-                                "transitions": transitions, "memories": m, "hazards": hazards},
+                                "transitions": transitions, "memories": m, "hazards": hazards,
+                                **scope},
                  **LOGIC_FIGURES},
         seconds=round(time.perf_counter() - t0, 6))
 

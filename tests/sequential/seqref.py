@@ -174,3 +174,41 @@ def random_reduced_table(rng, C: int, inputs: int = 2, p: float = 0.9):
     out = [[(r >> j) & 1 for j in range(width)] for r in range(C)]
     return FlowTable([f"x{i}" for i in range(inputs)], [f"z{j}" for j in range(width)],
                      [i ^ (i >> 1) for i in range(K)], [f"s{r}" for r in range(C)], nxt, out)
+
+
+def visited_rows(ft) -> set[int]:
+    """Rows a table can be in from power-up (stable, or passed through on a chain of unstable
+    entries), by a plain search over stable total states; the power-up column is the one the
+    table names, else the initial row's first stable column."""
+    n = len(ft.inputs)
+    k0 = ft.initial_column if ft.initial_column is not None else next(
+        k for k in range(len(ft.columns)) if ft.next[ft.initial][k] == ft.initial)
+    seen, todo, rows = {(k0, ft.initial)}, [(k0, ft.initial)], {ft.initial}
+    while todo:
+        k, r = todo.pop()
+        for i in range(n):
+            x2 = ft.columns[k] ^ (1 << (n - 1 - i))
+            if x2 not in ft.columns:
+                continue
+            k2 = ft.columns.index(x2)
+            cur = ft.next[r][k2]
+            while cur is not None:
+                rows.add(cur)
+                if ft.next[cur][k2] == cur:
+                    break
+                cur = ft.next[cur][k2]
+            if cur is not None and (k2, cur) not in seen:
+                seen.add((k2, cur))
+                todo.append((k2, cur))
+    return rows
+
+
+def chain_rows(ft, r: int, k: int) -> list[int]:
+    """Rows an entry passes through to its stable row ([] for '-')."""
+    out, cur = [], ft.next[r][k]
+    while cur is not None and len(out) <= len(ft.rows):
+        out.append(cur)
+        if ft.next[cur][k] == cur:
+            break
+        cur = ft.next[cur][k]
+    return out

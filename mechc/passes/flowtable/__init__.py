@@ -3,6 +3,9 @@ elements and output equations (``001_…`` Appendix B, done by program).
 
 Steps, each a plain function in its own module, run in this order by ``synthesise.py``:
 
+0. ``reach.reachable`` / ``reach.prune_table``: rows never visited from the initial state
+   (specified single-input changes, chains of unstable entries followed) are dropped, with a
+   warning naming them (``SeqEquations.warnings``; compile prints them on stderr).
 1. ``compatibles.compatibility``: the implication table (pairs of rows that may share a state).
 2. ``compatibles.closed_cover``: a minimum closed cover of compatibles (exact by integer
    programming over the prime compatibles for small tables; over the maximal compatibles, not

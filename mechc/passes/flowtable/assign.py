@@ -180,3 +180,23 @@ def given_assignment(ft: FlowTable, comp: np.ndarray) -> tuple[list[frozenset[in
         classes.append(frozenset(members))
         codes.append(int(code, 2) if code else 0)
     return classes, codes, width
+
+
+def drop_constant_bits(asg: Assignment) -> tuple[Assignment, list[int]]:
+    """The assignment without the variables that have one value in every merged row (a given
+    ``assign`` whose other rows were unreachable): such a memory would never be set or reset
+    and is not built. Dropping a variable that separates no two codes keeps every code distinct
+    and every transition's subcube to itself. Returns it and the dropped positions (MSB
+    first)."""
+    v = asg.width
+    gone = [j for j in range(v)
+            if len({(c >> (v - 1 - j)) & 1 for c in asg.codes}) == 1]
+    if not gone:
+        return asg, []
+    keep = [j for j in range(v) if j not in gone]
+
+    def squeeze(c: int) -> int:
+        return sum(((c >> (v - 1 - j)) & 1) << (len(keep) - 1 - i) for i, j in enumerate(keep))
+
+    return Assignment([squeeze(c) for c in asg.codes], len(keep), asg.proven,
+                      asg.method), gone

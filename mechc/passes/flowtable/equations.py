@@ -37,6 +37,7 @@ class SeqEquations:
     assignment: dict = field(default_factory=dict)
     essential_hazards: list[dict] = field(default_factory=list)
     checked: dict = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)  # for the user (compile prints them)
     seconds: float = 0.0
 
     def text(self, name: str) -> str:
@@ -56,6 +57,8 @@ class SeqEquations:
             "essential_hazards": self.essential_hazards,
             "checked": self.checked,
         }
+        if self.warnings:
+            d["warnings"] = list(self.warnings)
         if self.form == "table":
             d["merged_rows"] = self.classes
             d["assignment"] = {"variables": list(self.memories), "codes": dict(self.codes),

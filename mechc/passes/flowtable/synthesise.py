@@ -10,7 +10,12 @@ import numpy as np
 
 from mechc.errors import DesignError
 from mechc.ir.seqspec import FlowTable, SeqSpec, bits_text
-from mechc.passes.flowtable.assign import Assignment, assign_states, given_assignment
+from mechc.passes.flowtable.assign import (
+    Assignment,
+    assign_states,
+    drop_constant_bits,
+    given_assignment,
+)
 from mechc.passes.flowtable.check import check_equations
 from mechc.passes.flowtable.compatibles import (
     CoverResult,
@@ -28,6 +33,7 @@ from mechc.passes.flowtable.equations import (
 from mechc.passes.flowtable.excite import excitation, next_state_map
 from mechc.passes.flowtable.hazards import double_changes, essential_hazards
 from mechc.passes.flowtable.options import MAX_TOTAL_VARIABLES, SynthOptions
+from mechc.passes.flowtable.reach import prune_table, reach_warnings, reachable
 from mechc.passes.flowtable.reduce import ReducedTable, reduce_table
 from mechc.passes.minimise import minimise
 
@@ -41,7 +47,11 @@ def synthesise_table(spec: SeqSpec, opts: SynthOptions | None = None,
     the sign of its literals); the mapper's inverter count is not, so the pipeline tries them."""
     opts = opts or SynthOptions()
     t0 = time.perf_counter()
-    ft = spec.table
+    full = spec.table
+    reach = reachable(full)
+    ft = prune_table(full, reach)
+    sspec = replace(spec, table=ft, _tables=None) if reach.dropped else spec
+    warnings = reach_warnings(spec.path, full, reach)
     comp = compatibility(ft)
     if ft.assign:
         classes, codes, width = given_assignment(ft, comp)
@@ -53,14 +63,22 @@ def synthesise_table(spec: SeqSpec, opts: SynthOptions | None = None,
         cover = closed_cover(ft, comp, opts.time_limit)
         rt = reduce_table(ft, cover.classes)
         asg = assign_states(rt, opts.time_limit)
+    if ft.secondary is not None and len(ft.secondary) != asg.width:
+        raise DesignError(f"'secondary' names {len(ft.secondary)} state variable(s); the "
+                          f"assignment needs {asg.width}")
+    names_given = list(ft.secondary) if ft.secondary else None
+    asg, constant = drop_constant_bits(asg)
+    if constant:
+        where = ", ".join(names_given[j] if names_given else f"bit {j + 1}" for j in constant)
+        warnings.append(f"state variable(s) {where} have one value in every reachable row "
+                        "(never set or reset): not built")
+        if names_given:
+            names_given = [nm for j, nm in enumerate(names_given) if j not in constant]
     if polarity:
         asg = replace(asg, codes=[c ^ polarity for c in asg.codes])
     v = asg.width
-    if ft.secondary is not None and len(ft.secondary) != v:
-        raise DesignError(f"'secondary' names {len(ft.secondary)} state variable(s); the "
-                          f"assignment needs {v}")
     taken = set(ft.inputs) | set(ft.outputs)
-    mem = list(ft.secondary) if ft.secondary else unique_names(
+    mem = names_given if names_given else unique_names(
         [f"y{j + 1}" for j in range(v)], taken)
     if ft.n + v > MAX_TOTAL_VARIABLES:
         raise DesignError(f"{ft.n} inputs and {v} state variables: at most "
@@ -72,7 +90,7 @@ def synthesise_table(spec: SeqSpec, opts: SynthOptions | None = None,
     fix: set[tuple[int, int, int]] = set()
     for _ in range(8):
         exc = excitation(rt, asg, names, maps, fix)
-        se = excitation_equations(spec, exc, mem, opts,
+        se = excitation_equations(sspec, exc, mem, opts,
                                   {m: (init_code >> (v - 1 - j)) & 1 for j, m in enumerate(mem)})
         bad = double_changes(rt, asg, exc, se)
         if not bad:
@@ -85,11 +103,13 @@ def synthesise_table(spec: SeqSpec, opts: SynthOptions | None = None,
     se.codes = {rt.name(c): bits_text(asg.codes[c], v) for c in range(len(rt.classes))}
     se.state_codes = {ft.rows[r]: bits_text(asg.codes[_holding(rt, r)], v)
                       for r in range(len(ft.rows))}
-    se.cover = {"rows": len(ft.rows), "merged": len(rt.classes), "proven_minimum": cover.proven,
+    se.cover = {"rows": len(full.rows), "unreachable_rows": [full.rows[r] for r in reach.dropped],
+                "merged": len(rt.classes), "proven_minimum": cover.proven,
                 "candidates": cover.candidates, "method": cover.method}
+    se.warnings = warnings
     se.assignment = {"width": v, "proven_minimum": asg.proven, "method": asg.method}
     se.essential_hazards = essential_hazards(rt, asg, mem)
-    se.checked = check_equations(spec, se)
+    se.checked = check_equations(spec, se)  # against the table as written
     se.seconds = time.perf_counter() - t0
     return se
 
