@@ -47,11 +47,11 @@ def compile_options(c: argparse.ArgumentParser) -> None:
                    default="conventional",
                    help="threshold: outputs of up to 3 inputs as THRESHOLD generators (001 Ch. "
                    "III); auto: only where that costs fewer parts (default: %(default)s)")
-    g.add_argument("--levels", choices=["2", "multi", "auto"], default="auto",
+    g.add_argument("--levels", choices=["2", "multi", "auto"], default=None,
                    help="2: sums of products; multi: multi-level logic (Yosys/ABC, mapped to "
                    "the cells by parts; a BLIF or Verilog network is kept as its author wrote "
-                   "it); auto: build both and keep the one with fewer parts (default: "
-                   "%(default)s)")
+                   "it); auto: build both and keep the one with fewer parts (default: multi "
+                   "for Verilog, 2 for the rest: auto runs Yosys on every compile)")
     g.add_argument("--no-share", action="store_true",
                    help="do not share product terms between outputs")
     g.add_argument("--keep-hazards", action="store_true",
@@ -104,8 +104,14 @@ def options_from_args(args: argparse.Namespace) -> CompileOptions:
         cell_dirs=tuple(args.cell_dirs),
         amplify=not getattr(args, "no_amplify", False),
         timings=getattr(args, "timings", False),
-        levels=getattr(args, "levels", "2"),
+        levels=getattr(args, "levels", None) or default_levels(getattr(args, "spec", "")),
     )
+
+
+def default_levels(spec: object) -> str:
+    """Multi-level for Verilog (a two-level flattening of a datapath is rarely wanted), two
+    levels for the rest: ``auto`` builds both, which makes every compile run Yosys."""
+    return "multi" if str(spec).endswith(".v") else "2"
 
 
 def check_forces(args: argparse.Namespace) -> None:
