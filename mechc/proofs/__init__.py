@@ -1,12 +1,14 @@
-"""Proofs of a design against its spec at four levels (logic, kinematic, dynamic, timing), for
-combinational and sequential designs: :func:`prove` runs the engine registered for the level
-and the spec's kind, with :class:`ProofSettings`, and returns a :class:`ProofReport`."""
+"""Proofs of a design against its spec at five levels (logic, kinematic, dynamic, timing,
+screened), for combinational and sequential designs: :func:`prove` runs the engine registered
+for the level and the spec's kind, with :class:`ProofSettings`, and returns a
+:class:`ProofReport`."""
 
 # each engine module registers its proof with mechc.proofs.registry when imported
 from mechc.proofs import (  # noqa: F401
     dynamic,
     kinematic,
     logic,
+    screen,
     seq_logic,
     seq_mechanism,
     timing,

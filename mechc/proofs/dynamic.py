@@ -176,15 +176,18 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                   cells: list[str] | None = None, prune: bool = PRUNE_DEFAULT,
                   max_cases: int | None = None, record: list | None = None,
                   freeze: str | None = None, trace: TraceRecorder | None = None,
-                  jobs: int = 1, scheduler: str | None = None) -> ProofReport:
+                  jobs: int = 1, scheduler: str | None = None,
+                  only: list[int] | None = None) -> ProofReport:
     """Every change is a case of its own: it runs on a scene built at rest (the closed form)
     in its start state, so cases can run on ``jobs`` processes or on the Dask cluster at
     ``scheduler`` (:mod:`mechc.proofs.parallel`) and the report is the serial one, case by
     case. ``prune``: that scene holds only what can move the outputs (``mechc.proofs.prune``);
     else the whole mechanism (or ``cells``). A design with a stateful cell runs the whole
     tour on one scene (its rest depends on the past), in this process. ``max_cases`` keeps
-    the first changes of the plan only; ``record`` (a list) receives each change's inputs and
-    final output positions (for step-halving checks); ``freeze``: which still bodies a pruned
+    the first changes of the plan only, ``only`` the changes of the plan at these indices
+    (the screened proof, ``mechc.proofs.screen``); ``record`` (a list) receives each change's
+    inputs, final output positions and measures (for step-halving checks and the screen);
+    ``freeze``: which still bodies a pruned
     scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``)."""
     t0 = time.perf_counter()
     st = settings or dyn_settings(design)
@@ -211,6 +214,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     pairs, chosen = plan_changes(design, names, extra, seed, independent=not one_scene)
     if max_cases is not None:
         pairs = pairs[:max_cases]
+    if only is not None:
+        pairs = [pairs[i] for i in only]
     vectors = [vec for _, vec in pairs]
 
     def columns(vs: list[int]) -> np.ndarray:
@@ -249,7 +254,12 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         if record is not None:
             record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation,
                            "max_penetration_mm": r.max_penetration,
-                           "settle_time_s": r.settle_time, "steps": r.steps})
+                           "settle_time_s": r.settle_time, "steps": r.steps,
+                           "servo_lag_end_mm": r.servo_lag_end,
+                           "held_deviation": {o: float(np.max(np.abs(r.outputs[o] - b)))
+                                              for o in spec.outputs if o in r.outputs
+                                              and (b := int(before[o][i])) != DC
+                                              and b == int(after[o][i])}})
 
         def fail(kind, case=case, **info):
             counts[kind] += 1

@@ -17,7 +17,7 @@ from mechc.ir.spec import Spec
 from mechc.proofs.report import ProofReport
 from mechc.proofs.settings import ProofSettings
 
-LEVELS = ("logic", "kinematic", "dynamic", "timing")
+LEVELS = ("logic", "kinematic", "dynamic", "timing", "screened")
 KINDS = ("combinational", "sequential")
 #: Called as (done, total) while a long proof runs.
 OnProgress = Callable[[int, int], None]

@@ -221,9 +221,15 @@ def prove_timing(design: Design, spec: Spec, lib: Library,
 
 def predict_changes(design: Design, lib: Library, names: list[str],
                     changes: list[tuple[int, int]], st: DynSettings,
-                    tables: dict[str, CellTable | None]) -> list[dict]:
+                    tables: dict[str, CellTable | None], detail: bool = False) -> list[dict]:
     """Per change (from input vector, to input vector; one input differs): its switching
-    outputs' predicted ``switch_s``, ``settle_s`` and the path of cells that sets them."""
+    outputs' predicted ``switch_s``, ``settle_s`` and the path of cells that sets them. With
+    ``detail`` (what the screened proof reads, :mod:`mechc.proofs.screen`) also: ``switched``,
+    the cells whose output switches and in which direction; ``nets_settle_s``, the latest
+    predicted settle of any switching net, internal ones included (an internal net's closed
+    form ends with the move); ``closed_form_end`` and ``closed_form_swing``, every output's
+    closed-form position at the move's end and its largest distance from its start along
+    the move."""
     mech, nl = design.mechanism, design.netlist
     types = {c.id: c.cell for c in nl.cells.values()}
     n = len(names)
@@ -256,6 +262,18 @@ def predict_changes(design: Design, lib: Library, names: list[str],
             arrive, settle, path = _paths(nl, "in:" + moving, switched, figs)
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
+            if detail:
+                rec["switched"] = {c.id: bool(logic[c.outputs[0]][2 * i + 1])
+                                   for c in nl.cells.values() if c.outputs[0] in switched}
+                rec["nets_settle_s"] = st.move_time + max(
+                    (v for net, v in settle.items() if net in switched), default=0.0)
+                rec["closed_form_end"] = {}
+                rec["closed_form_swing"] = {}
+                for o in nl.outputs:
+                    if o in sig:
+                        s = sig[o][i * SAMPLES:(i + 1) * SAMPLES]
+                        rec["closed_form_end"][o] = float(s[-1])
+                        rec["closed_form_swing"][o] = float(np.max(np.abs(s - s[0])))
             for o, net in nl.outputs.items():
                 if net not in switched or o not in sig:
                     continue
@@ -273,6 +291,8 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                                      "closed_form_settle_s": round(cf_settle, 6),
                                      "path": path.get(net, [cid] if cid else [])}
                 rec["settle_s"] = max(rec["settle_s"], rec["outputs"][o]["settle_s"])
+            if detail:
+                rec["nets_settle_s"] = max(rec["nets_settle_s"], rec["settle_s"])
             out.append(rec)
     return out
 

@@ -1,0 +1,335 @@
+"""Screened level: the dynamic proof's verdict, with pymunk run only on the input changes
+the timing level cannot vouch for (the default proof of ``mechc simulate``).
+
+The whole-scene dynamic proof (:mod:`mechc.proofs.dynamic`) stays the reference: the screen
+runs its plan, its scenes and its checks, on fewer changes. Every change of the plan is timed
+first (:mod:`mechc.proofs.timing`, no scene); a change is *cleared* only when, for every kind
+of failure the dynamic proof can report, the screen models it with a stated margin:
+
+- ``settle``: the latest predicted settle of any switching net, grown by ``SETTLE_MARGIN``
+  (twice the timing model's worst error measured by ``benchmarks/timing.py``), is within the
+  move and the hold.
+- ``rest``: every output's closed-form end is within ``tolerance - REST_MARGIN`` of what the
+  spec asks (a settled scene stands within ``SETTLED`` of its closed form: twice that).
+- ``glitch``: every output that must hold is held by the logic whatever order its cells
+  switch in (ternary simulation, the moving input unknown: no hazard under any delays), and
+  its closed form along the move stays within ``tolerance - HELD_MARGIN`` of its value.
+- ``solver``, ``contact``, ``stall``: local to the cells that move. Every (cell kind,
+  direction) a cleared change switches is switched by a change that ran in pymunk, and those
+  runs stayed below the limits by ``SOLVER_FACTOR``.
+
+Anything else goes to dynamics with its reason: a switching cell without a table, a switching
+AMPLIFIER (a toggle, timed as built on other changes), a held output with a possible hazard,
+small slack. What the model assumes is checked on the changes that ran (the *calibration*):
+their measured settle within the model's error, held outputs' excess over the closed form
+within half ``HELD_MARGIN``, joints, contacts and servo lag within the limits by
+``SOLVER_FACTOR``. If any check fails every change runs in pymunk. A design that holds state
+(its rest depends on the past), a sequential design, a run asked for a pose trace or for an
+accuracy: the whole dynamic proof, and the report says so.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+
+import numpy as np
+
+from mechc.cells.characterise import SETTLED
+from mechc.cells.library import Library
+from mechc.ir.design import Design
+from mechc.ir.logic_types import evaluate_type, table_rows
+from mechc.ir.netlist import Netlist
+from mechc.ir.seqspec import SeqSpec
+from mechc.ir.spec import Spec
+from mechc.logic.cubes import DC
+from mechc.physics.scene import DynSettings
+from mechc.proofs.dynamic import dynamic_engine, plan_changes, prove_dynamic
+from mechc.proofs.prune import blocker
+from mechc.proofs.registry import OnProgress, check_interface, engine
+from mechc.proofs.report import ProofReport
+from mechc.proofs.seq_mechanism import sequential_dynamic_engine
+from mechc.proofs.settings import ProofSettings, dyn_settings
+from mechc.proofs.timing import cell_tables, predict_changes
+
+#: The timing model's worst settle error on the benchmark circuits (20.7 %, random81,
+#: ``benchmarks/timing.py``), rounded up.
+MODEL_ERROR = 0.25
+#: Safety factor on that error: a change is cleared when its predicted settle times
+#: ``1 + SETTLE_MARGIN`` is within the move and the hold.
+SETTLE_MARGIN = 2.0 * MODEL_ERROR
+#: A settled scene's outputs stand within SETTLED of the closed form; twice that.
+REST_MARGIN = 2.0 * SETTLED
+#: Share of the tolerance kept for the dynamics on an output that must hold.
+HELD_MARGIN_SHARE = 0.5
+#: The changes that ran must stay below the joint, contact and servo-lag limits by this: on
+#: random81 the worst change's stretch and overrun were at most 1.26x the worst of the changes
+#: that ran (``benchmarks/screen.py``), times 1.5.
+SOLVER_FACTOR = 2.0
+#: A cell with more inputs than this is not simulated in ternary: its output is unknown.
+TERNARY_MAX_FANIN = 12
+#: Per-change decisions kept in the report.
+MAX_LISTED = 200
+
+
+@engine("screened", "combinational")
+def screened_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
+                    progress: OnProgress | None) -> ProofReport:
+    """The dynamic proof's verdict with pymunk run only where the timing level cannot vouch."""
+    why = None
+    if settings.accuracy is not None:
+        why = "--accuracy chooses the solver settings on the whole run"
+    elif settings.trace is not None:
+        why = "a pose trace records every change"
+    elif settings.prune:
+        why = "--prune asks for per-change pruned scenes"
+    elif blocker(design.netlist, lib) is not None:
+        why = blocker(design.netlist, lib)
+    if why is not None:
+        return _unscreened(dynamic_engine(design, spec, lib, settings, progress), why)
+    return prove_screened(design, spec, lib, settings, progress)
+
+
+@engine("screened", "sequential")
+def seq_screened_engine(design: Design, spec: SeqSpec, lib: Library, settings: ProofSettings,
+                        progress: OnProgress | None) -> ProofReport:
+    """A sequential design: every transition runs in pymunk (the timing level does not
+    model a memory's transitions; its ordering requirements are checked by the walk)."""
+    return _unscreened(sequential_dynamic_engine(design, spec, lib, settings, progress),
+                       "sequential: every transition runs in pymunk")
+
+
+def _unscreened(rep: ProofReport, why: str) -> ProofReport:
+    """The whole dynamic proof's report, saying why the screen was not applied."""
+    rep.figures["screen"] = {"applied": False, "reason": why,
+                             "text": f"screen not applied ({why}): every change ran in pymunk"}
+    return rep
+
+
+def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
+                   progress: OnProgress | None = None) -> ProofReport:
+    """See the module docstring."""
+    t0 = time.perf_counter()
+    check_interface(design.netlist, spec)
+    st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time)
+    n = len(spec.inputs)
+    pairs, timed, decisions = decide(design, spec, lib, settings, st)
+    budget = st.move_time + st.settle_time
+    held_margin = HELD_MARGIN_SHARE * settings.tolerance
+    run = [i for i, d in enumerate(decisions) if d["route"] == "dynamic"]
+    record: list[dict] = []
+    kw = {"tolerance": settings.tolerance, "extra": settings.cases, "seed": settings.seed,
+          "jobs": settings.jobs, "scheduler": settings.scheduler}
+    rep = prove_dynamic(design, spec, lib, st, progress=progress, only=run, record=record, **kw)
+    for i, r in zip(run, record):
+        decisions[i]["measured_settle_s"] = (round(r["settle_time_s"] + st.move_time, 5)
+                                             if math.isfinite(r["settle_time_s"]) else None)
+    bad = calibrate(decisions, timed, run, record, st, held_margin, settings.tolerance,
+                    design.mechanism.ctx.stroke)
+    if bad:
+        rest = [i for i, d in enumerate(decisions) if d["route"] == "timing"]
+        for i in rest:
+            decisions[i]["route"] = "dynamic"
+            decisions[i]["why"].append("calibration failed: " + bad[0])
+        if rest:
+            more = prove_dynamic(design, spec, lib, st, progress=progress, only=rest, **kw)
+            rep = _merge(rep, more)
+        run = sorted(run + rest)
+    cleared = len(pairs) - len(run)
+    text = (f"screen: {len(run)} of {len(pairs)} changes ran in pymunk, {cleared} cleared by "
+            f"timing (cleared when predicted settle x {1 + SETTLE_MARGIN:g} <= "
+            f"{budget:.3f} s, i.e. slack >= {SETTLE_MARGIN:.0%} of the settle)"
+            + (f"; calibration failed ({bad[0]}): every change ran" if bad else ""))
+    reasons: dict[str, int] = {}
+    for d in decisions:
+        if d["route"] == "dynamic":
+            key = d["why"][0].split(":")[0] if d["why"] else "?"
+            key = ("slack" if key.startswith("slack") else "amplifier" if
+                   key.startswith("amplifier") else key)
+            reasons[key] = reasons.get(key, 0) + 1
+    rep.figures["screen"] = {
+        "applied": True, "text": text, "changes": len(pairs), "dynamic": len(run),
+        "cleared_by_timing": cleared, "budget_s": round(budget, 5),
+        "settle_margin": SETTLE_MARGIN, "rest_margin_fraction": REST_MARGIN,
+        "held_margin_fraction": held_margin, "solver_factor": SOLVER_FACTOR,
+        "calibration": bad or "passed", "decisions": decisions[:MAX_LISTED]}
+    rep.level = "screened"
+    rep.cases = len(pairs)
+    rep.coverage = {**rep.coverage, "tour": min(len(pairs), (1 << n) - 1) if n <= 10 else 0,
+                    "ran_in_pymunk": len(run), "cleared_by_timing": cleared}
+    rep.seconds = round(time.perf_counter() - t0, 4)
+    return rep
+
+
+def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st: DynSettings
+           ) -> tuple[list[tuple[int, int]], list[dict], list[dict]]:
+    """The dynamic proof's plan, each change timed, and each change's route (``dynamic`` or
+    ``timing``) with the reasons it must run in pymunk."""
+    nl = design.netlist
+    names = list(spec.inputs)
+    n = len(names)
+    pairs, _chosen = plan_changes(design, names, settings.cases, settings.seed,
+                                  independent=True)
+    tables, _tabs = cell_tables(design, lib, None, names, pairs)
+    timed = predict_changes(design, lib, names, pairs, st, tables, detail=True)
+    before = spec.values_at(_columns([a for a, _ in pairs], n))
+    after = spec.values_at(_columns([b for _, b in pairs], n))
+    held_ok = held_by_logic(nl, names, pairs)
+    budget = st.move_time + st.settle_time
+    amps = {cid for cid, tab in tables.items() if tab is not None and tab.as_built}
+    kind = {c.id: _kind(c) for c in nl.cells.values()}
+    held_margin = HELD_MARGIN_SHARE * settings.tolerance
+    decisions: list[dict] = []
+    for i, rec in enumerate(timed):
+        why: list[str] = []
+        sw = rec["switched"]
+        untimed = sorted(c for c in sw if tables.get(c) is None)
+        if untimed:
+            why.append(f"no timing table for switching cell(s) {', '.join(untimed[:3])}")
+        amp = sorted(c for c in sw if c in amps)
+        if amp:
+            why.append(f"amplifier {', '.join(amp[:3])} switches")
+        need = rec["nets_settle_s"] * (1.0 + SETTLE_MARGIN)
+        slack = budget - rec["nets_settle_s"]
+        if need > budget:
+            why.append(f"slack {slack:.4f} s < {SETTLE_MARGIN:.0%} of the predicted settle "
+                       f"{rec['nets_settle_s']:.4f} s")
+        for o in spec.outputs:
+            want, was = int(after[o][i]), int(before[o][i])
+            end = rec["closed_form_end"].get(o)
+            if want == DC or end is None:
+                continue
+            if abs(end - want) > settings.tolerance - REST_MARGIN:
+                why.append(f"{o}: closed-form rest {abs(end - want):.4f} from {want} (cleared "
+                           f"within {settings.tolerance - REST_MARGIN:.4f})")
+            if want == was:
+                if not held_ok[o][i]:
+                    why.append(f"{o} must hold: a hazard is possible (ternary simulation)")
+                dev = abs(end - want) + rec["closed_form_swing"][o]
+                if dev > settings.tolerance - held_margin:
+                    why.append(f"{o} must hold: closed form moves {dev:.4f} (cleared within "
+                               f"{settings.tolerance - held_margin:.4f})")
+        decisions.append({"inputs": rec["inputs"], "moving": rec["moving"], "to": rec["to"],
+                          "route": "dynamic" if why else "timing", "why": why,
+                          "predicted_settle_s": round(rec["nets_settle_s"], 5),
+                          "slack_s": round(slack, 5)})
+    # the cleared changes' cells (kind, direction) each switched by a change run in pymunk
+    covered = {(kind[c], d) for dec, rec in zip(decisions, timed) if dec["route"] == "dynamic"
+               for c, d in rec["switched"].items()}
+    need_cover = {(kind[c], d) for dec, rec in zip(decisions, timed) if dec["route"] == "timing"
+                  for c, d in rec["switched"].items()} - covered
+    while need_cover:
+        best = max((i for i, d in enumerate(decisions) if d["route"] == "timing"),
+                   key=lambda i: (len({(kind[c], d) for c, d in timed[i]["switched"].items()}
+                                      & need_cover), -i))
+        got = {(kind[c], d) for c, d in timed[best]["switched"].items()} & need_cover
+        decisions[best]["route"] = "dynamic"
+        decisions[best]["why"].append(f"witness: the first run of {len(got)} (cell kind, "
+                                      "direction) the cleared changes switch")
+        need_cover -= got
+    return pairs, timed, decisions
+
+
+def calibrate(decisions: list[dict], timed: list[dict], run: list[int], record: list[dict],
+              st: DynSettings, held_margin: float, tolerance: float, stroke: float
+              ) -> list[str]:
+    """What the changes run in pymunk say against the screen's model (empty: nothing)."""
+    bad: list[str] = []
+    for i, r in zip(run, record):
+        where = f"change {i} ({decisions[i]['moving']} to {decisions[i]['to']})"
+        if r["max_violation_mm"] * SOLVER_FACTOR > st.violation_limit or \
+                not math.isfinite(r["max_violation_mm"]):
+            bad.append(f"{where}: joint stretch {r['max_violation_mm']:.4g} mm within "
+                       f"{SOLVER_FACTOR:g}x of the limit {st.violation_limit:g} mm")
+        if r["max_penetration_mm"] * SOLVER_FACTOR > st.penetration_limit:
+            bad.append(f"{where}: contact overrun {r['max_penetration_mm']:.4g} mm within "
+                       f"{SOLVER_FACTOR:g}x of the limit {st.penetration_limit:g} mm")
+        lag = r.get("servo_lag_end_mm", 0.0)
+        if lag * SOLVER_FACTOR > tolerance * stroke:
+            bad.append(f"{where}: input ended {lag:.4g} mm short, within {SOLVER_FACTOR:g}x "
+                       f"of the stall limit {tolerance * stroke:.4g} mm")
+        s = r["settle_time_s"]
+        pred = timed[i]["nets_settle_s"]
+        if not math.isfinite(s) or (s > 0 and s + st.move_time > pred * (1 + MODEL_ERROR)):
+            bad.append(f"{where}: settled {s + st.move_time:.4f} s, predicted {pred:.4f} s "
+                       f"(model error bound {MODEL_ERROR:.0%})")
+        for o, dev in r.get("held_deviation", {}).items():
+            cf = timed[i]["closed_form_swing"].get(o, 0.0)
+            if dev - cf > held_margin / 2:
+                bad.append(f"{where}: held output {o} moved {dev:.4f}, closed form {cf:.4f} "
+                           f"(margin {held_margin:.4f})")
+    return bad
+
+
+def _merge(a: ProofReport, b: ProofReport) -> ProofReport:
+    """Two dynamic reports on disjoint changes of one plan as one."""
+    kinds = dict(a.failure_kinds or {})
+    for k, v in (b.failure_kinds or {}).items():
+        kinds[k] = kinds.get(k, 0) + v
+    fig = dict(a.figures)
+    for k in ("max_position_error_fraction", "max_deviation_fraction",
+              "max_contact_penetration_mm", "max_settle_time_s"):
+        fig[k] = max(a.figures.get(k) or 0.0, b.figures.get(k) or 0.0)
+    if (b.figures.get("max_joint_violation_mm") or 0) > (a.figures.get("max_joint_violation_mm")
+                                                         or 0):
+        fig["max_joint_violation_mm"] = b.figures["max_joint_violation_mm"]
+        fig["worst_joint"] = b.figures["worst_joint"]
+    fig["min_margin_fraction"] = round(0.5 - fig["max_deviation_fraction"], 6)
+    fig["steps"] = a.figures.get("steps", 0) + b.figures.get("steps", 0)
+    # design checks are listed by both: once
+    design = [f for f in b.failures if f.get("kind") == "design check"]
+    extra = [f for f in b.failures if f.get("kind") != "design check"]
+    count = a.failure_count + b.failure_count - len(design)
+    return ProofReport(level=a.level, kind=a.kind, passed=a.passed and b.passed,
+                       cases=a.cases + b.cases, coverage=a.coverage, failure_count=count,
+                       failure_kinds=kinds or None, failures=(a.failures + extra)[:50],
+                       figures=fig, seconds=a.seconds + b.seconds)
+
+
+def held_by_logic(nl: Netlist, names: list[str], pairs: list[tuple[int, int]]
+                  ) -> dict[str, np.ndarray]:
+    """Per output and change: whether the output is the same for every order in which the
+    cells can switch — the moving input unknown (X), each cell's output known only where
+    every completion of its unknown inputs agrees (ternary simulation; a definite output has
+    no static hazard under any cell delays)."""
+    n = len(names)
+    m = len(pairs)
+    can0: dict[str, np.ndarray] = {}
+    can1: dict[str, np.ndarray] = {}
+    for k, nm in enumerate(names):
+        a = np.array([(c >> (n - 1 - k)) & 1 for c, _ in pairs], dtype=bool)
+        b = np.array([(v >> (n - 1 - k)) & 1 for _, v in pairs], dtype=bool)
+        can0[nm] = ~a | ~b
+        can1[nm] = a | b
+    for c in nl.topo_cells():
+        k = len(c.inputs)
+        if k > TERNARY_MAX_FANIN or not c.outputs:
+            z = np.ones(m, dtype=bool)
+            for net in c.outputs:
+                can0[net], can1[net] = z, z
+            continue
+        rows = table_rows(k)
+        out = np.asarray(evaluate_type(c.type, rows, c.params, 1 << k), dtype=bool)
+        R = np.array(rows, dtype=bool).T.reshape(1 << k, k)  # row x input
+        i0 = np.array([can0[x] for x in c.inputs]).reshape(k, m)
+        i1 = np.array([can1[x] for x in c.inputs]).reshape(k, m)
+        # feasible[row, change]: every input can take the row's value
+        feas = np.all(np.where(R[:, :, None], i1[None], i0[None]), axis=1)
+        o1 = np.any(feas & out[:, None], axis=0)
+        o0 = np.any(feas & ~out[:, None], axis=0)
+        for net in c.outputs:
+            can0[net], can1[net] = o0, o1
+    return {o: ~(can0[net] & can1[net]) for o, net in nl.outputs.items()}
+
+
+def _kind(c) -> str:
+    """What makes two cell instances alike for the solver: library cell, type, fan-in,
+    parameters."""
+    return json.dumps([c.cell, c.type, len(c.inputs), c.params], sort_keys=True, default=str)
+
+
+def _columns(vs: list[int], n: int) -> np.ndarray:
+    return np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in vs],
+                    dtype=bool).reshape(len(vs), n).T
