@@ -1,0 +1,151 @@
+"""The screened proof (``mechc simulate``'s default, ``--level screened``) against the whole-scene
+dynamic proof (``--level dynamic``), both run here on the same circuits, in one process, one
+after the other.
+
+    python benchmarks/screen.py [--only NAME ...] [--random N] [--out DIR]
+
+Circuits: those of ``benchmarks/timing.py`` (the sorter, the full adder, random23, random81, the
+2-bit adder with carry-in) and ``--random`` held-out random specs (3-4 inputs, 1-2 outputs,
+seeds 9100..; compiled by mechc as ``mechc.bench.circuits.random_compiled`` compiles). For
+each: both proofs' seconds and verdicts, the ratio, how many changes the screen ran in pymunk,
+and, from the dynamic proof's own record of every change, whether any change the screen cleared
+failed there (the soundness check) and how the worst joint stretch and contact overrun over all
+changes compare with the worst over the changes the screen chose to run before any fallback
+(the basis of
+``mechc.proofs.screen.SOLVER_FACTOR``). Writes ``screen.csv`` to ``--out`` (default docs/perf).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from timing import LIB, circuits  # noqa: E402
+
+from mechc.ir.spec import OutputSpec, Spec  # noqa: E402
+from mechc.logic.cubes import Cube  # noqa: E402
+from mechc.pipeline import compile_spec  # noqa: E402
+from mechc.proofs.dynamic import prove_dynamic  # noqa: E402
+from mechc.proofs.screen import prove_screened  # noqa: E402
+from mechc.proofs.settings import ProofSettings, dyn_settings  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def heldout(k: int) -> list[tuple[str, object, None]]:
+    """``k`` random specs never used to set the screen's margins, compiled."""
+    out = []
+    for j in range(k):
+        seed = 9100 + j
+        rng = np.random.default_rng(seed)
+        n_in, n_out = 3 + j % 2, 1 + (j // 2) % 2
+        funcs = {}
+        for o in range(n_out):
+            t = rng.random(1 << n_in)
+            on = np.flatnonzero(t < 0.45)
+            dc = np.flatnonzero((t >= 0.45) & (t < 0.5))
+            funcs[f"z{o}"] = OutputSpec(f"z{o}", on=[Cube.minterm(int(x), n_in) for x in on],
+                                        dc=[Cube.minterm(int(x), n_in) for x in dc])
+        spec = Spec(f"heldout{seed}", "bool", [f"x{i}" for i in range(n_in)], list(funcs),
+                    funcs)
+        out.append((f"heldout{seed}", compile_spec(spec), None))
+    return out
+
+
+def failed_changes(rec: list[dict], report, st) -> set[int]:
+    """Indices of the plan's changes the dynamic proof failed (from its record and its
+    listed failures, matched by target vector and moving input)."""
+    bad = set()
+    listed = {(tuple(sorted(f["inputs"].items())), f["moving"]) for f in report.failures
+              if "inputs" in f}
+    for i, r in enumerate(rec):
+        key = (tuple(sorted(r["inputs"].items())), r["moving"])
+        if (key in listed or r["max_violation_mm"] > st.violation_limit
+                or r["max_penetration_mm"] > st.penetration_limit
+                or not math.isfinite(r["settle_time_s"])):
+            bad.add(i)
+    return bad
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", action="append", default=[], metavar="NAME")
+    ap.add_argument("--random", type=int, default=4, metavar="N",
+                    help="held-out random specs (default %(default)s)")
+    ap.add_argument("--out", default=str(ROOT / "docs" / "perf"))
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    for name, design, _ in [*circuits(True), *heldout(args.random)]:
+        if args.only and name not in args.only:
+            continue
+        spec = design.spec
+        st = dyn_settings(design)
+        settings = ProofSettings()
+        rec: list[dict] = []
+        t0 = time.perf_counter()
+        full = prove_dynamic(design, spec, LIB, st, record=rec)
+        t_full = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        scr = prove_screened(design, spec, LIB, settings)
+        t_scr = time.perf_counter() - t0
+        sc = scr.figures["screen"]
+        dec = sc["decisions"]
+        ran = [i for i, d in enumerate(dec) if d["route"] == "dynamic"]
+        # the changes the screen chose before any fallback: what calibrated it
+        chose = [i for i in ran if not any(w.startswith("calibration failed")
+                                           for w in dec[i]["why"])]
+        bad = failed_changes(rec, full, st)
+        missed = sorted(i for i in bad if dec[i]["route"] == "timing")
+        worst = {k: max((r[k] for r in rec), default=0.0)
+                 for k in ("max_violation_mm", "max_penetration_mm")}
+        worst_ran = {k: max((rec[i][k] for i in chose), default=0.0) for k in worst}
+        rho = {k: worst[k] / worst_ran[k] if worst_ran[k] > 0 else float("nan")
+               for k in worst}
+        row = {"circuit": name, "cells": len(design.netlist.cells), "changes": len(rec),
+               "ran_in_pymunk": len(ran), "chosen_by_screen": len(chose),
+               "cleared_by_timing": sc["cleared_by_timing"],
+               "calibration": "passed" if sc["calibration"] == "passed"
+               else sc["calibration"][0],
+               "dynamic_s": round(t_full, 2), "screened_s": round(t_scr, 2),
+               "speedup": round(t_full / t_scr, 2), "dynamic_passed": full.passed,
+               "screened_passed": scr.passed, "changes_failed_by_dynamic": len(bad),
+               "failed_changes_cleared": len(missed),
+               "worst_stretch_mm": round(worst["max_violation_mm"], 5),
+               "stretch_all_over_ran": round(rho["max_violation_mm"], 3),
+               "worst_overrun_mm": round(worst["max_penetration_mm"], 5),
+               "overrun_all_over_ran": round(rho["max_penetration_mm"], 3)}
+        rows.append(row)
+        print(row, flush=True)
+    if not rows:
+        return
+    with open(out / "screen.csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print("\n| circuit | cells | changes | ran in pymunk | dynamic s | screened s | speed-up | "
+          "verdicts (dynamic / screened) | failed changes cleared | calibration |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['circuit']} | {r['cells']} | {r['changes']} | {r['ran_in_pymunk']} | "
+              f"{r['dynamic_s']} | {r['screened_s']} | {r['speedup']}x | "
+              f"{'pass' if r['dynamic_passed'] else 'FAIL'} / "
+              f"{'pass' if r['screened_passed'] else 'FAIL'} | {r['failed_changes_cleared']} | "
+              f"{r['calibration']} |")
+    unsound = [r["circuit"] for r in rows if r["failed_changes_cleared"]
+               or (r["screened_passed"] and not r["dynamic_passed"])]
+    print(f"changes the dynamic proof failed that the screen cleared: "
+          f"{sum(r['failed_changes_cleared'] for r in rows)}"
+          + (f" (in {', '.join(unsound)})" if unsound else ""))
+
+
+if __name__ == "__main__":
+    main()

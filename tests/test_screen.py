@@ -1,0 +1,232 @@
+"""The screened proof (``mechc.proofs.screen``): its ternary hazard check against a textbook
+hazard and a brute-force second implementation, its calibration on made-up runs, and its
+verdicts against the whole-scene dynamic proof of the same changes, case by case, on
+examples, held-out random specs, a forced failure and a flow table."""
+
+from __future__ import annotations
+
+import itertools
+import json
+
+import numpy as np
+import pytest
+
+from mechc.bench.circuits import random_netlist
+from mechc.cells.library import load_library
+from mechc.frontends import load_spec
+from mechc.frontends.fsm import parse_fsm_file
+from mechc.ir.logic_types import evaluate_type
+from mechc.ir.netlist import CellInst, Netlist
+from mechc.ir.spec import OutputSpec, Spec
+from mechc.logic.cubes import Cube
+from mechc.physics.scene import DynSettings
+from mechc.pipeline import compile_spec
+from mechc.proofs import ProofSettings, prove
+from mechc.proofs.dynamic import plan_changes, prove_dynamic
+from mechc.proofs.screen import (
+    MODEL_ERROR,
+    SOLVER_FACTOR,
+    calibrate,
+    decide,
+    held_by_logic,
+    prove_screened,
+)
+from mechc.proofs.settings import dyn_settings
+from tests.helpers import EXAMPLES
+
+LIB = load_library()
+
+
+def _hazard_netlist(consensus: bool) -> Netlist:
+    """z = a.b + a'.c, with the consensus term b.c when asked."""
+    nl = Netlist(["a", "b", "c"])
+    nl.add_cell(CellInst("n", "not", "NOT", ("a",), ("na",)))
+    nl.add_cell(CellInst("t1", "and", "AND", ("a", "b"), ("p",)))
+    nl.add_cell(CellInst("t2", "and", "AND", ("na", "c"), ("q",)))
+    ors = ["p", "q"]
+    if consensus:
+        nl.add_cell(CellInst("t3", "and", "AND", ("b", "c"), ("r",)))
+        ors.append("r")
+    nl.add_cell(CellInst("o", "or", "OR", tuple(ors), ("z",)))
+    nl.set_output("z", "z")
+    return nl
+
+
+def test_ternary_finds_the_textbook_static_hazard_and_its_cure():
+    # a moving with b = c = 1: z is 1 before and after, but a.b falls as a'.c rises
+    change = [(0b011, 0b111), (0b111, 0b011)]
+    assert not held_by_logic(_hazard_netlist(False), ["a", "b", "c"], change)["z"].any()
+    # the consensus term b.c holds z whatever order the gates switch in
+    assert held_by_logic(_hazard_netlist(True), ["a", "b", "c"], change)["z"].all()
+    # b moving with a = 1, c = 0: z follows b (switches), so it is not held
+    assert not held_by_logic(_hazard_netlist(True), ["a", "b", "c"], [(0b100, 0b110)])["z"][0]
+
+
+def _ternary_brute(nl: Netlist, names: list[str], cur: int, vec: int) -> dict[str, bool]:
+    """Second implementation: per cell, the set of values over every completion of its
+    unknown inputs, by enumeration (no arrays)."""
+    n = len(names)
+    val: dict[str, set[bool]] = {}
+    for k, nm in enumerate(names):
+        val[nm] = {bool((cur >> (n - 1 - k)) & 1), bool((vec >> (n - 1 - k)) & 1)}
+    for c in nl.topo_cells():
+        outs = set()
+        for combo in itertools.product(*[sorted(val[x]) for x in c.inputs]):
+            arr = [np.array([v]) for v in combo]
+            outs.add(bool(evaluate_type(c.type, arr, c.params, 1)[0]))
+        for net in c.outputs:
+            val[net] = outs
+    return {o: len(val[net]) == 1 for o, net in nl.outputs.items()}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_ternary_matches_a_brute_force_on_random_netlists(seed):
+    nl = random_netlist(30, n_inputs=5, seed=seed)
+    names = list(nl.inputs)
+    pairs = [(a, a ^ (1 << b)) for a in range(32) for b in range(5)]
+    got = held_by_logic(nl, names, pairs)
+    for i, (cur, vec) in enumerate(pairs):
+        ref = _ternary_brute(nl, names, cur, vec)
+        for o in nl.outputs:
+            assert bool(got[o][i]) == ref[o], (seed, cur, vec, o)
+    # a definite output never differs between the change's two ends (a necessary condition)
+    ev = nl.evaluate({nm: np.array([[(c >> (4 - k)) & 1, (v >> (4 - k)) & 1] for c, v in pairs],
+                                   dtype=bool).ravel() for k, nm in enumerate(names)})
+    for o, net in nl.outputs.items():
+        ends = np.asarray(ev[net]).reshape(-1, 2)
+        assert not np.any(got[o] & (ends[:, 0] != ends[:, 1]))
+
+
+def _rec(**kw) -> dict:
+    base = {"max_violation_mm": 0.0, "max_penetration_mm": 0.0, "settle_time_s": 0.0,
+            "servo_lag_end_mm": 0.0, "held_deviation": {}}
+    return {**base, **kw}
+
+
+def test_calibration_flags_each_kind_of_disagreement():
+    st = DynSettings()
+    dec = [{"moving": "a", "to": 1}]
+    timed = [{"nets_settle_s": 0.1, "closed_form_swing": {"z": 0.0}}]
+
+    def bad(**kw) -> list[str]:
+        return calibrate(dec, timed, [0], [_rec(**kw)], st, 0.025, 0.05, 20.0)
+
+    assert bad() == []
+    # a joint stretched within SOLVER_FACTOR of the limit: just inside, just outside
+    assert bad(max_violation_mm=st.violation_limit / SOLVER_FACTOR * 0.99) == []
+    assert bad(max_violation_mm=st.violation_limit / SOLVER_FACTOR * 1.01)
+    assert bad(max_penetration_mm=st.penetration_limit / SOLVER_FACTOR * 1.01)
+    assert bad(servo_lag_end_mm=0.05 * 20.0 / SOLVER_FACTOR * 1.01)
+    # settled later than the prediction plus the model's error, or never
+    late = 0.1 * (1 + MODEL_ERROR) - st.move_time
+    assert bad(settle_time_s=late * 0.99) == []
+    assert bad(settle_time_s=late * 1.01 + 1e-4)
+    assert bad(settle_time_s=float("inf"))
+    # a held output moved more than half the held margin beyond its closed form
+    assert bad(held_deviation={"z": 0.012}) == []
+    assert bad(held_deviation={"z": 0.013})
+
+
+def _by_change(report) -> dict[tuple, list[str]]:
+    """The report's failures by (target vector, moving input, direction)."""
+    out: dict[tuple, list[str]] = {}
+    for f in report.failures:
+        if "inputs" in f:
+            key = (tuple(sorted(f["inputs"].items())), f["moving"], f["to"])
+            out.setdefault(key, []).append(json.dumps(f, sort_keys=True))
+    return out
+
+
+def _same_as_dynamic(design, st=None, settings=None) -> dict:
+    """Screened and whole dynamic proof of ``design``: same verdict, and for every change the
+    screen ran, the same failures; no change the dynamic proof failed was cleared."""
+    settings = settings or ProofSettings()
+    st = st or dyn_settings(design)
+    full = prove_dynamic(design, design.spec, LIB, st, tolerance=settings.tolerance)
+    scr = prove_screened(design, design.spec, LIB, settings, st=st)
+    assert scr.level == "screened" and full.level == "dynamic"
+    assert scr.passed == full.passed
+    assert scr.cases == full.cases
+    dec = scr.figures["screen"]["decisions"]
+    ran = {(tuple(sorted(d["inputs"].items())), d["moving"], d["to"]) for d in dec
+           if d["route"] == "dynamic"}
+    cleared = {(tuple(sorted(d["inputs"].items())), d["moving"], d["to"]) for d in dec
+               if d["route"] == "timing"} - ran
+    f_full, f_scr = _by_change(full), _by_change(scr)
+    assert not set(f_full) & cleared  # never cleared a change the dynamic proof failed
+    for key in ran:
+        assert f_full.get(key, []) == f_scr.get(key, []), key
+    assert scr.failure_kinds == full.failure_kinds
+    return scr.figures["screen"]
+
+
+def test_screened_equals_dynamic_on_the_sorter_and_runs_few_changes():
+    d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+    screen = _same_as_dynamic(d)
+    assert screen["applied"] and screen["calibration"] == "passed"
+    assert screen["dynamic"] + screen["cleared_by_timing"] == screen["changes"] == 31
+    assert screen["dynamic"] <= 4
+    assert "of 31 changes ran in pymunk" in screen["text"]
+
+
+@pytest.mark.slow
+def test_a_hold_too_short_fails_the_screened_proof_as_the_dynamic_one():
+    d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+    st = dyn_settings(d)
+    st.settle_time = 0.003  # 3 ms after the move: the outputs cannot have settled
+    screen = _same_as_dynamic(d, st=st)
+    # every change goes to dynamics: its slack cannot cover the model's error
+    assert screen["cleared_by_timing"] == 0
+
+
+def test_the_screen_routes_small_slack_to_dynamics_with_its_reason():
+    d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+    st = dyn_settings(d)
+    st.settle_time = 0.03  # budget 0.11 s: a prediction of 0.08 s x 1.5 does not fit
+    pairs, timed, dec = decide(d, d.spec, LIB, ProofSettings(), st)
+    names = list(d.spec.inputs)
+    assert pairs == plan_changes(d, names, 16, 0, independent=True)[0]
+    for t, x in zip(timed, dec):
+        slack_small = t["nets_settle_s"] * 1.5 > st.move_time + st.settle_time
+        assert (x["route"] == "dynamic") >= slack_small
+        assert any(w.startswith("slack") for w in x["why"]) == slack_small
+
+
+def _random_spec(seed: int, n_in: int, n_out: int) -> Spec:
+    rng = np.random.default_rng(seed)
+    funcs = {}
+    for o in range(n_out):
+        t = rng.random(1 << n_in)
+        funcs[f"z{o}"] = OutputSpec(
+            f"z{o}", on=[Cube.minterm(int(x), n_in) for x in np.flatnonzero(t < 0.45)],
+            dc=[Cube.minterm(int(x), n_in) for x in np.flatnonzero((t >= 0.45) & (t < 0.5))])
+    return Spec(f"heldout{seed}", "bool", [f"x{i}" for i in range(n_in)], list(funcs), funcs)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed,n_in,n_out", [(9200, 3, 2), (9201, 4, 1)])
+def test_screened_equals_dynamic_on_held_out_random_specs(seed, n_in, n_out):
+    _same_as_dynamic(compile_spec(_random_spec(seed, n_in, n_out)))
+
+
+@pytest.mark.slow
+def test_a_flow_table_runs_every_transition_and_gives_the_dynamic_report():
+    ft = parse_fsm_file(EXAMPLES / "gated_latch.fsm")
+    d = compile_spec(ft)
+    full = prove(d, ft, LIB, "dynamic")
+    scr = prove(d, ft, LIB, "screened")
+    assert scr.figures["screen"]["applied"] is False
+    assert scr.passed == full.passed and scr.failures == full.failures
+    assert scr.cases == full.cases
+
+
+def test_simulate_defaults_to_the_screened_level(cli, tmp_path):
+    rep = tmp_path / "r.json"
+    code, out, _ = cli("simulate", EXAMPLES / "sorter.bool", "--jobs", "1", "--report", rep)
+    assert code == 0
+    assert "level screened" in out and "changes ran in pymunk" in out
+    doc = json.loads(rep.read_text())
+    assert doc["level"] == "screened" and doc["screen"]["applied"]
+    code, out, err = cli("simulate", EXAMPLES / "sorter.bool", "--level", "timing",
+                         "--scheduler", "tcp://127.0.0.1:1")
+    assert code == 2 and "--scheduler" in err
