@@ -133,14 +133,16 @@ def test_kinematic_trace_rest_poses_put_outputs_where_the_spec_says(cli, tmp_pat
 
 def test_dynamic_trace_ends_at_the_closed_form_and_leaves_the_proof_alone(cli, tmp_path,
                                                                           sorter_json):
-    code, trace, report = run_trace(cli, tmp_path, sorter_json, "--cases", "2")
+    code, trace, report = run_trace(cli, tmp_path, sorter_json, "--cases", "2",
+                                    "--level", "dynamic")
     assert code == 0
     validate(trace)
     assert trace["level"] == "dynamic" and len(trace["cases"]) == report["cases"] == 17
     assert {b["id"] for b in trace["bodies"]} == design_body_ids(json.loads(
         sorter_json.read_text()))
     plain = tmp_path / "plain.json"
-    assert cli("simulate", sorter_json, "--cases", "2", "--report", plain)[0] == 0
+    assert cli("simulate", sorter_json, "--cases", "2", "--level", "dynamic", "--report",
+               plain)[0] == 0
     without = json.loads(plain.read_text())
     for r in (report, without):
         r.pop("seconds")

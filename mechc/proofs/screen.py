@@ -14,9 +14,14 @@ of failure the dynamic proof can report, the screen models it with a stated marg
 - ``glitch``: every output that must hold is held by the logic whatever order its cells
   switch in (ternary simulation, the moving input unknown: no hazard under any delays), and
   its closed form along the move stays within ``tolerance - HELD_MARGIN`` of its value.
-- ``solver``, ``contact``, ``stall``: local to the cells that move. Every (cell kind,
+- ``solver``, ``contact``, ``stall``: *not modelled* by the timing level (joint stretch and
+  contact overrun vary from change to change in ways the switching cells do not explain:
+  random81's worst stretch came on a change of 5 switching cells). Every (cell kind,
   direction) a cleared change switches is switched by a change that ran in pymunk, and those
-  runs stayed below the limits by ``SOLVER_FACTOR``.
+  runs must stay below each limit by ``SOLVER_FACTOR``, the worst ratio measured between a
+  plan's worst change and the worst change the screen ran, times 1.5. This is a measured
+  margin, not a bound: a design whose changes come nearer a limit than that runs every
+  change in pymunk.
 
 Anything else goes to dynamics with its reason: a switching cell without a table, a switching
 AMPLIFIER (a toggle, timed as built on other changes), a held output with a possible hazard,
@@ -64,10 +69,10 @@ REST_MARGIN = 2.0 * SETTLED
 #: Share of the tolerance kept for the dynamics on an output that must hold.
 HELD_MARGIN_SHARE = 0.5
 #: The changes that ran must stay below the joint, contact and servo-lag limits by this. The
-#: timing level does not model them; the worst change of a plan was up to 3.1x the worst of
-#: the changes the screen chose to run (contact overrun, the sorter; ``benchmarks/screen.py``),
+#: timing level does not model them; the worst change of a plan was up to 3.7x the worst of
+#: the changes the screen chose to run (contact overrun, random23; ``benchmarks/screen.py``),
 #: times 1.5, rounded up.
-SOLVER_FACTOR = 5.0
+SOLVER_FACTOR = 6.0
 #: A cell with more inputs than this is not simulated in ternary: its output is unknown.
 TERNARY_MAX_FANIN = 12
 #: Per-change decisions kept in the report.
