@@ -23,14 +23,15 @@ of failure the dynamic proof can report, the screen models it with a stated marg
   margin, not a bound: a design whose changes come nearer a limit than that runs every
   change in pymunk.
 
-Anything else goes to dynamics with its reason: a switching cell without a table, a switching
-AMPLIFIER (a toggle, timed as built on other changes), a held output with a possible hazard,
-small slack. What the model assumes is checked on the changes that ran (the *calibration*):
-their measured settle within the model's error, held outputs' excess over the closed form
-within half ``HELD_MARGIN``, joints, contacts and servo lag within the limits by
-``SOLVER_FACTOR``. If any check fails every change runs in pymunk. A design that holds state
-(its rest depends on the past), a sequential design, a run asked for a pose trace or for an
-accuracy: the whole dynamic proof, and the report says so.
+Anything else goes to dynamics with its reason: a switching cell without a table or outside
+the move times and loads its table measured, a switching AMPLIFIER (a toggle, timed as built
+on other changes), a held output with a possible hazard, small slack. What the model assumes
+is checked on the changes that ran (the *calibration*): their measured settle within the
+model's error, held outputs' excess over the closed form within half ``HELD_MARGIN``, joints,
+contacts and servo lag within the limits by ``SOLVER_FACTOR``. If any check fails every
+change runs in pymunk. A design that holds state (its rest depends on the past), a sequential
+design, a run asked for a pose trace or for an accuracy: the whole dynamic proof, and the
+report says so.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ import time
 
 import numpy as np
 
-from mechc.cells.characterise import SETTLED
+from mechc.cells.characterise import SETTLED, CellTable
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.ir.logic_types import evaluate_type, table_rows
@@ -56,7 +57,7 @@ from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.seq_mechanism import sequential_dynamic_engine
 from mechc.proofs.settings import ProofSettings, dyn_settings
-from mechc.proofs.timing import cell_tables, predict_changes
+from mechc.proofs.timing import cell_tables, net_loads, predict_changes
 
 #: The timing model's worst settle error on the benchmark circuits (20.7 %, random81,
 #: ``benchmarks/timing.py``), rounded up.
@@ -187,6 +188,7 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
     held_ok = held_by_logic(nl, names, pairs)
     budget = st.move_time + st.settle_time
     amps = {cid for cid, tab in tables.items() if tab is not None and tab.as_built}
+    loads = net_loads(design)
     kind = {c.id: _kind(c) for c in nl.cells.values()}
     held_margin = HELD_MARGIN_SHARE * settings.tolerance
     decisions: list[dict] = []
@@ -196,6 +198,12 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
         untimed = sorted(c for c in sw if tables.get(c) is None)
         if untimed:
             why.append(f"no timing table for switching cell(s) {', '.join(untimed[:3])}")
+        outside = sorted(c for c in sw if tables.get(c) is not None
+                         and not _in_grid(tables[c], st.move_time,
+                                          loads.get(nl.cells[c].outputs[0], 0.0)))
+        if outside:
+            why.append(f"switching cell(s) {', '.join(outside[:3])} outside their measured "
+                       "move times or loads")
         amp = sorted(c for c in sw if c in amps)
         if amp:
             why.append(f"amplifier {', '.join(amp[:3])} switches")
@@ -330,6 +338,14 @@ def held_by_logic(nl: Netlist, names: list[str], pairs: list[tuple[int, int]]
         for net in c.outputs:
             can0[net], can1[net] = o0, o1
     return {o: ~(can0[net] & can1[net]) for o, net in nl.outputs.items()}
+
+
+def _in_grid(tab: CellTable, move_time: float, load: float) -> bool:
+    """Whether a table measured ``move_time`` and ``load`` (it is held at its edges, never
+    extrapolated: outside, the model does not cover the cell)."""
+    eps = 1e-9
+    return (tab.move_times[0] - eps <= move_time <= tab.move_times[-1] + eps
+            and tab.loads[0] - eps <= load <= tab.loads[-1] + eps)
 
 
 def _kind(c) -> str:
