@@ -167,6 +167,7 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     rep.level = "screened"
     rep.cases = len(pairs)
     rep.coverage = {**rep.coverage, "tour": min(len(pairs), (1 << n) - 1) if n <= 10 else 0,
+                    **({"transitions": len(pairs)} if "transitions" in rep.coverage else {}),
                     "ran_in_pymunk": len(run), "cleared_by_timing": cleared}
     rep.seconds = round(time.perf_counter() - t0, 4)
     return rep
