@@ -12,7 +12,9 @@ and, from the dynamic proof's own record of every change, whether any change the
 failed there (the soundness check) and how the worst joint stretch and contact overrun over all
 changes compare with the worst over the changes the screen chose to run before any fallback
 (the basis of
-``mechc.proofs.screen.SOLVER_FACTOR``). Writes ``screen.csv`` to ``--out`` (default docs/perf).
+``mechc.proofs.screen.SOLVER_FACTOR``). Writes ``screen.csv`` and ``screen.png`` (seconds of
+both proofs per circuit) to ``--out`` (default docs/perf); ``--chart-from CSV`` redraws the
+chart of an earlier run.
 """
 
 from __future__ import annotations
@@ -24,7 +26,11 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import LIB, circuits  # noqa: E402
@@ -80,9 +86,14 @@ def main() -> None:
     ap.add_argument("--random", type=int, default=4, metavar="N",
                     help="held-out random specs (default %(default)s)")
     ap.add_argument("--out", default=str(ROOT / "docs" / "perf"))
+    ap.add_argument("--chart-from", metavar="CSV", help="only redraw the chart of this CSV")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.chart_from:
+        with open(args.chart_from, newline="") as f:
+            chart(list(csv.DictReader(f)), out / "screen.png")
+        return
     rows = []
     for name, design, _ in [*circuits(True), *heldout(args.random)]:
         if args.only and name not in args.only:
@@ -131,6 +142,7 @@ def main() -> None:
         w = csv.DictWriter(f, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
+    chart(rows, out / "screen.png")
     print("\n| circuit | cells | changes | ran in pymunk | dynamic s | screened s | speed-up | "
           "verdicts (dynamic / screened) | failed changes cleared | calibration |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -145,6 +157,29 @@ def main() -> None:
     print(f"changes the dynamic proof failed that the screen cleared: "
           f"{sum(r['failed_changes_cleared'] for r in rows)}"
           + (f" (in {', '.join(unsound)})" if unsound else ""))
+
+
+def chart(rows: list[dict], path: Path) -> None:
+    """Both proofs' seconds per circuit (log scale), with the screened run's share of changes
+    in pymunk."""
+    fig, ax = plt.subplots(figsize=(9, 4))
+    x = np.arange(len(rows))
+    dyn = [float(r["dynamic_s"]) for r in rows]
+    scr = [float(r["screened_s"]) for r in rows]
+    ax.bar(x - 0.2, dyn, 0.4, label="whole dynamic proof")
+    ax.bar(x + 0.2, scr, 0.4, label="screened proof")
+    for k, r in enumerate(rows):
+        ax.text(k + 0.2, scr[k] * 1.1, f"{r['ran_in_pymunk']}/{r['changes']}\n"
+                f"{float(r['speedup']):.1f}x", ha="center", va="bottom", fontsize=7)
+    ax.set_xticks(x, [r["circuit"] for r in rows], rotation=20, fontsize=8)
+    ax.set_yscale("log")
+    ax.set_ylabel("seconds, wall clock (log)")
+    ax.set_title("screened vs whole dynamic proof (changes in pymunk / all; speed-up)",
+                 fontsize=10)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
