@@ -231,3 +231,13 @@ def test_simulate_defaults_to_the_screened_level(cli, tmp_path):
     code, out, err = cli("simulate", EXAMPLES / "sorter.bool", "--level", "timing",
                          "--scheduler", "tcp://127.0.0.1:1")
     assert code == 2 and "--scheduler" in err
+
+
+def test_a_move_time_the_tables_never_measured_goes_to_dynamics():
+    d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+    for move_time, outside in ((0.08, False), (0.3, True), (0.02, True)):
+        st = dyn_settings(d, move_time=move_time)
+        _, timed, dec = decide(d, d.spec, LIB, ProofSettings(move_time=move_time), st)
+        for t, x in zip(timed, dec):
+            said = any("outside their measured" in w for w in x["why"])
+            assert said == (outside and bool(t["switched"])), (move_time, x)
