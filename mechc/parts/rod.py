@@ -144,19 +144,28 @@ class Rod(JointKind):
 
     @classmethod
     def violation(cls, j: Joint, a: Body | None, b: Body | None, poses: Poses, size: int,
-                  tol: float) -> np.ndarray:
-        """|distance - length| > 1e-6, squared: no square root."""
+                  tol: float) -> np.ndarray | None:
+        """|distance - length| > 1e-6, squared: no square root. The smallest and largest
+        squared distance decide first: when both are in the band no state breaks the rod
+        (None: nothing to mark), and the states are compared one by one only otherwise."""
         ax_, ay_ = placed_position(a, poses, j.pa)
         bx_, by_ = placed_position(b, poses, j.pb)
         g2, ey = bx_ - ax_, by_ - ay_  # the differences are temporaries: squared in place
         g2 *= g2
         ey *= ey
         g2 += ey
-        viol = g2 > (j.length + 1e-6) ** 2
-        if not is_number(j.length):  # a length per sample (a tolerance run)
+        hi2 = (j.length + 1e-6) ** 2
+        if is_number(j.length):
+            lo2 = (j.length - 1e-6) ** 2 if j.length > 1e-6 else -math.inf
+            # NaN states (not placed) break nothing, here as below: fmin/fmax pass them over
+            if (g2.size and np.fmax.reduce(g2, axis=None) <= hi2
+                    and np.fmin.reduce(g2, axis=None) >= lo2):
+                return None
+            viol = g2 > hi2
+            viol |= g2 < lo2
+        else:  # a length per sample (a tolerance run)
+            viol = g2 > hi2
             viol |= (j.length > 1e-6) & (g2 < (j.length - 1e-6) ** 2)
-        elif j.length > 1e-6:
-            viol |= g2 < (j.length - 1e-6) ** 2
         return sized(viol, size)
 
     @classmethod
