@@ -8,6 +8,7 @@ importing each other.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterator, MutableMapping
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -88,9 +89,10 @@ class Angles(_Entries):
         if not np.size(a):
             return None
         if domain == SIDES:
-            a = _sides_extreme_tan(a, *sides)
+            v = _sides_min_tan(a, *sides)
             domain = TAN
-        v = float(np.fmin.reduce(a, axis=None))  # NaN only if every state is NaN
+        else:
+            v = float(np.fmin.reduce(a, axis=None))  # NaN only if every state is NaN
         if math.isnan(v):
             return math.nan
         return math.degrees(math.atan(v)) if domain == TAN else v
@@ -111,16 +113,46 @@ def sides_tan(d2, r2, l2):
         return np.fmax(H, 0.0) / np.abs(u)
 
 
-def _sides_extreme_tan(d2: np.ndarray, r2, l2) -> np.ndarray:
-    """The tangents of the angles at the smallest and largest d² (where the smallest angle
-    is: the angle rises to 90° at d² = r² + l² and falls on both sides, 0 past closing); every
-    state's where the dimensions vary per state or a d² is 0 (a side of no length, whose
-    angle the closed form leaves undefined or 0 by the sign of r² - l²)."""
+def _sides_min_tan(d2: np.ndarray, r2, l2) -> float:
+    """The smallest of :func:`sides_tan` over the states (NaN if every state is NaN): at the
+    smallest or the largest d² (the angle rises to 90° at d² = r² + l² and falls on both
+    sides, 0 past closing), those two worked out in Python floats (the same IEEE operations
+    as numpy's, so the same values, without a numpy call per operation); every state's where
+    the dimensions vary per state or a d² is 0 (a side of no length, whose angle the closed
+    form leaves undefined or 0 by the sign of r² - l²)."""
+    global _LAST_SIDES
     if isinstance(r2, (float, int)) and isinstance(l2, (float, int)):
-        lo = np.fmin.reduce(d2, axis=None)
-        if not lo == 0:  # NaN (every state undefined) included
-            return sides_tan(np.array([lo, np.fmax.reduce(d2, axis=None)]), r2, l2)
-    return sides_tan(d2, r2, l2)
+        last = _LAST_SIDES  # one array serves the transmission and the toggle checks
+        if last[0]() is d2 and last[1] == r2 and last[2] == l2 and not d2.flags.writeable:
+            return last[3]
+        lo = float(np.fmin.reduce(d2, axis=None))
+        if math.isnan(lo):  # every state undefined
+            return math.nan
+        if lo != 0:
+            a = _sides_tan_1(lo, r2, l2)
+            b = _sides_tan_1(float(np.fmax.reduce(d2, axis=None)), r2, l2)
+            v = a if b != b or a <= b else b  # the smaller, NaN passed over (as fmin)
+            _LAST_SIDES = (weakref.ref(d2), r2, l2, v)
+            return v
+    return float(np.fmin.reduce(sides_tan(d2, r2, l2), axis=None))
+
+
+#: the last (d² by weak reference, r², l², smallest tangent) worked out: a read-only d² is not
+#: changed since, and the reference does not keep a proof's chunk alive
+_LAST_SIDES: tuple = (lambda: None, None, None, math.nan)
+
+
+def _sides_tan_1(d2: float, r2: float, l2: float) -> float:
+    """:func:`sides_tan` of one d² > 0 (inf included), operation for operation."""
+    inv = 1.0 / d2
+    A = inv * (0.5 * (r2 - l2)) + 0.5
+    u = inv * r2
+    h2 = u - A * A
+    h = math.sqrt(h2) if h2 > 0 else 0.0  # fmax(NaN, 0): 0 past the toggle
+    w = abs(u - A)
+    if w == 0:
+        return math.inf if h > 0 else math.nan
+    return h / w
 
 
 class Turn:

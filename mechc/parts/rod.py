@@ -132,7 +132,10 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     # transmission: the angle between the rod and the lever arm (90° is ideal), 0 past the
     # toggle; kept as d² (arm, rod and d make a triangle: the law of cosines), converted at
     # the extreme only (``Angles.set_sides``)
-    d2 = sized(d2, size)  # read-only from here on: one array serves both checks
+    if d2.shape == (size,):
+        d2.flags.writeable = False  # one array serves both checks, unchanged from here on
+    else:
+        d2 = sized(d2, size)  # a read-only view
     poses.transmission.set_sides(j.id, d2, r2, L2)
     poses.singular_margin.set_sides(j.id, d2, r2, L2)
 

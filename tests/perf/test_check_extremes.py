@@ -118,3 +118,25 @@ def _mech_of(part: Part):
             return {b.id: b for b in part.bodies}
 
     return Mech()
+
+
+def test_the_shared_extreme_is_worked_out_once_and_only_for_an_unchanged_array():
+    """The transmission and toggle checks share one d² array: the second reading reuses the
+    first's extreme only while the array is read-only and the sides are the same."""
+    d2 = np.array([900.0, 1600.0, 2500.0])
+    d2.flags.writeable = False
+    t, m = Angles(), Angles()
+    t.set_sides("j", d2, 900.0, 1600.0)
+    m.set_sides("j", d2, 900.0, 1600.0)
+    first = t.min_deg("j")
+    assert m.min_deg("j") == first == pytest.approx(acute_deg(30.0, 40.0, 30.0), abs=1e-12)
+    other = Angles()
+    other.set_sides("j", d2, 900.0, 2500.0)  # the same d², other sides: its own extreme
+    assert other.min_deg("j") == pytest.approx(acute_deg(30.0, 50.0, 30.0), abs=1e-12)
+    assert abs(other.min_deg("j") - first) > 10
+    w = np.array([900.0, 1600.0, 2500.0])  # writable: worked out on every reading
+    a = Angles()
+    a.set_sides("j", w, 900.0, 1600.0)
+    assert a.min_deg("j") == pytest.approx(first, abs=1e-12)
+    w[0] = 1250.0
+    assert a.min_deg("j") == pytest.approx(acute_deg(30.0, 40.0, math.sqrt(1250.0)), abs=1e-12)
