@@ -161,15 +161,8 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
 
     th = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     mechc_rocker_pins(th[:1000])  # warm
-    best = math.inf
-    for _ in range(repeat):
-        t0 = time.process_time()
-        for s in range(0, n, CHUNK):
-            mechc_rocker_pins(th[s:s + CHUNK])
-        best = min(best, time.process_time() - t0)
-    mechc_rate = n / best
-    reduced_rate = n / _best_of(repeat, lambda: [mechc_rocker_pins_reduced(th[s:s + CHUNK])
-                                                  for s in range(0, n, CHUNK)])
+    mechc_rate = n / _best_of(repeat, lambda: _chunks(mechc_rocker_pins, th))
+    reduced_rate = n / _best_of(repeat, lambda: _chunks(mechc_rocker_pins_reduced, th))
     # pylinkage, Python API
     lk = pylinkage_linkage(n_step)
     t0 = time.process_time()
@@ -197,8 +190,7 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
     ref = mechc_rocker_pins(th[:CHUNK])
     if np.max(np.abs(bare_rocker_pins(th[:CHUNK]) - ref)) > 1e-9:
         raise AssertionError("the positions-only closed form does not match mechc's")
-    bare_rate = n / _best_of(repeat, lambda: [bare_rocker_pins(th[s:s + CHUNK])
-                                               for s in range(0, n, CHUNK)])
+    bare_rate = n / _best_of(repeat, lambda: _chunks(bare_rocker_pins, th))
     kernel_rate = None
     if nc.HAS_NUMBA:
         pins = _numba_kernel()
@@ -210,6 +202,13 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
     return PeerResult(mechc_rate, step_rate, fast_rate,
                       "numba" if nc.HAS_NUMBA else "python", diff, n, bare_rate, kernel_rate,
                       reduced_rate)
+
+
+def _chunks(fn, th: np.ndarray) -> None:
+    """``fn`` on ``th`` in chunks of CHUNK states, each result dropped at once (as a proof's
+    sweep keeps only what it reduces: keeping them all would time the heap's growth too)."""
+    for s in range(0, len(th), CHUNK):
+        fn(th[s:s + CHUNK])
 
 
 def _best_of(repeat: int, fn) -> float:
