@@ -71,16 +71,17 @@ def degree_domain(monkeypatch) -> None:
     def arccos_deg(c):
         return np.degrees(np.arccos(np.clip(c, 0.0, 1.0)))
 
-    def arctan2_deg(y, x):
-        return np.arctan2(y, x) * (180.0 / np.pi)
+    def law_of_cosines(self, key, d2, r2, l2):  # the acute angle between sides r and l
+        c = np.abs(r2 + l2 - d2) / (2.0 * np.sqrt(r2 * l2))
+        self[key] = arccos_deg(c)
 
-    for mod, names in ((rod, {"line_tan": line_deg, "line_cotan": complement_deg,
-                              "ratio_tan": arctan2_deg}),
+    for mod, names in ((rod, {"line_tan": line_deg, "line_cotan": complement_deg}),
                        (groove, {"arccos_tan": arccos_deg, "line_cotan": complement_deg}),
                        (closed_form, {"line_tan": line_deg})):
         for name, fn in names.items():
             monkeypatch.setattr(mod, name, fn)
     monkeypatch.setattr(Angles, "set_tan", Angles.__setitem__)
+    monkeypatch.setattr(Angles, "set_sides", law_of_cosines)
 
 
 class Keep(CheckStats):

@@ -50,6 +50,20 @@ def mechc_rocker_pins(crank_angles: np.ndarray) -> np.ndarray:
     return np.stack(position(part.bodies[1], poses, b), axis=1)
 
 
+def mechc_rocker_pins_reduced(crank_angles: np.ndarray) -> np.ndarray:
+    """:func:`mechc_rocker_pins` and, as a proof's ``CheckStats`` does on every chunk, the
+    checks reduced to their figures: each angle's smallest value in degrees and each body's
+    count of unsolvable states."""
+    part, b = mechc_part()
+    poses = solve(part, {"crank": np.asarray(crank_angles) - math.pi / 2}, len(crank_angles))
+    for figures in (poses.transmission, poses.singular_margin):
+        for jid in figures:
+            figures.min_deg(jid)
+    for bad in poses.bad.values():
+        np.count_nonzero(bad)
+    return np.stack(position(part.bodies[1], poses, b), axis=1)
+
+
 def pylinkage_linkage(steps_per_turn: int):
     # pylinkage is the benchmark's optional peer (the bench extra), never a dependency
     from pylinkage.actuators import Crank
@@ -130,6 +144,7 @@ class PeerResult:
     positions: int
     bare_numpy_per_s: float = math.nan  # positions only, numpy (bare_rocker_pins)
     numba_kernel_per_s: float | None = None  # positions only, compiled scalar loop
+    mechc_reduced_per_s: float = math.nan  # and the checks reduced to their figures
 
 
 # states per vectorised call, cache-sized. A proof's sweep chunks larger (budget // (3 bodies),
@@ -146,13 +161,8 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
 
     th = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     mechc_rocker_pins(th[:1000])  # warm
-    best = math.inf
-    for _ in range(repeat):
-        t0 = time.process_time()
-        for s in range(0, n, CHUNK):
-            mechc_rocker_pins(th[s:s + CHUNK])
-        best = min(best, time.process_time() - t0)
-    mechc_rate = n / best
+    mechc_rate = n / _best_of(repeat, lambda: _chunks(mechc_rocker_pins, th))
+    reduced_rate = n / _best_of(repeat, lambda: _chunks(mechc_rocker_pins_reduced, th))
     # pylinkage, Python API
     lk = pylinkage_linkage(n_step)
     t0 = time.process_time()
@@ -180,8 +190,7 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
     ref = mechc_rocker_pins(th[:CHUNK])
     if np.max(np.abs(bare_rocker_pins(th[:CHUNK]) - ref)) > 1e-9:
         raise AssertionError("the positions-only closed form does not match mechc's")
-    bare_rate = n / _best_of(repeat, lambda: [bare_rocker_pins(th[s:s + CHUNK])
-                                               for s in range(0, n, CHUNK)])
+    bare_rate = n / _best_of(repeat, lambda: _chunks(bare_rocker_pins, th))
     kernel_rate = None
     if nc.HAS_NUMBA:
         pins = _numba_kernel()
@@ -191,7 +200,15 @@ def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResul
         if np.max(np.abs(out[:CHUNK] - ref)) > 1e-9:
             raise AssertionError("the compiled closed form does not match mechc's")
     return PeerResult(mechc_rate, step_rate, fast_rate,
-                      "numba" if nc.HAS_NUMBA else "python", diff, n, bare_rate, kernel_rate)
+                      "numba" if nc.HAS_NUMBA else "python", diff, n, bare_rate, kernel_rate,
+                      reduced_rate)
+
+
+def _chunks(fn, th: np.ndarray) -> None:
+    """``fn`` on ``th`` in chunks of CHUNK states, each result dropped at once (as a proof's
+    sweep keeps only what it reduces: keeping them all would time the heap's growth too)."""
+    for s in range(0, len(th), CHUNK):
+        fn(th[s:s + CHUNK])
 
 
 def _best_of(repeat: int, fn) -> float:

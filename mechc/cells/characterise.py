@@ -40,8 +40,7 @@ import numpy as np
 
 from mechc.cells.cell import Cell
 from mechc.cells.library import Library
-from mechc.ir.logic_types import evaluate_type, table_rows
-from mechc.ir.netlist import CellInst, Netlist
+from mechc.cells.prove_cell import alone
 from mechc.physics.scene import DynSettings, Scene
 
 #: Bump when what is measured or how changes: older tables are then measured again.
@@ -122,27 +121,6 @@ def cache_dir() -> Path:
         return Path(env)
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(base) / "mechc" / "cells"
-
-
-def alone(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
-          stroke: float):
-    """The one-cell design (input sliders, the cell, output ``z``), as a cell is proven alone."""
-    # the pipeline sits above the cell layer (it imports this package): imported when used
-    from mechc.frontends.boolfile import parse_bool
-    from mechc.passes.assemble import MechOptions
-    from mechc.pipeline import CompileOptions, compile_netlist
-
-    nets = [f"i{k}" for k in range(n)]
-    table = evaluate_type(type_name, table_rows(n), params, 1 << n)
-    on = [str(r) for r in range(1 << n) if table[r]]
-    spec = parse_bool(f"inputs {' '.join(nets)}\noutputs z\n"
-                      + (f"z = minterms({', '.join(on)})\n" if on else "z = 0\n"),
-                      f"<cell {cls.name}>")
-    nl = Netlist(nets)
-    nl.add_cell(CellInst("c1", cls.name, type_name, tuple(nets), ("z",), params),
-                pin_names=cls.input_names(n), out_pins=list(cls.outputs))
-    nl.set_output("z", "z")
-    return compile_netlist(spec, nl, CompileOptions(mech=MechOptions(stroke=stroke)), lib), table
 
 
 #: Keys of a part's JSON that say where it stands, not what it is (left out of its hash).
@@ -340,14 +318,9 @@ class Tables:
         name = hashlib.sha256(json.dumps([mk, cls.source_sha256, VERSION],
                                          default=str).encode()).hexdigest()[:24]
         path = self.cache / f"{cell}-{name}.json"
-        if path.exists():
-            try:
-                tab = CellTable.from_json(json.loads(path.read_text()))
-                self._mem[mk] = tab
-                self.found["cached"] += 1
-                return tab
-            except (OSError, ValueError, KeyError):
-                pass  # a damaged cache entry is measured again
+        tab = self._from_cache(mk, path)
+        if tab is not None:
+            return tab
         say = self.progress
         tab = measure(cls, self.lib, type_name, n, params, stroke,
                       None if say is None else (lambda d, t: say(cell, d, t)))
@@ -361,6 +334,19 @@ class Tables:
         self._mem[mk] = tab
         return tab
 
+    def _from_cache(self, key, path: Path) -> CellTable | None:
+        """The table cached on disk at ``path`` (kept in memory under ``key``); None when
+        there is none or it is damaged (then it is measured again)."""
+        if not path.exists():
+            return None
+        try:
+            tab = CellTable.from_json(json.loads(path.read_text()))
+        except (OSError, ValueError, KeyError):
+            return None
+        self._mem[key] = tab
+        self.found["cached"] += 1
+        return tab
+
     def instance(self, design, cid: str, moves: Callable[[], list[Move]]) -> CellTable | None:
         """The table of cell ``cid`` as ``design`` built it (its own springs, dashpot and
         masses; keyed by that geometry's hash, cached), measured on a scene of that cell in
@@ -372,14 +358,9 @@ class Tables:
         if key in self._mem:
             return self._mem[key]
         path = self.cache / f"{c.cell}-{key}.json"
-        if path.exists():
-            try:
-                tab = CellTable.from_json(json.loads(path.read_text()))
-                self._mem[key] = tab
-                self.found["cached"] += 1
-                return tab
-            except (OSError, ValueError, KeyError):
-                pass  # a damaged cache entry is measured again
+        tab = self._from_cache(key, path)
+        if tab is not None:
+            return tab
         mv = moves()
         if not mv:
             return None

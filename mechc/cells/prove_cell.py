@@ -45,20 +45,15 @@ def user_cell_checks(design: Design, lib: Library) -> list[Check]:
     return out
 
 
-def prove_cell(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
-               stroke: float, key: tuple | None = None) -> list[Check]:
-    """The checks of one cell proven alone (cached; [] while its own proof is running, for the
-    one-cell design's design checks come back here)."""
-    from mechc.frontends.boolfile import parse_bool  # the pipeline imports this module's users
+def alone(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
+          stroke: float) -> tuple[Design, list]:
+    """The one-cell design (input sliders ``i0``.., the cell, output ``z``) as a cell is
+    proven and characterised alone, and the cell type's truth table over its inputs."""
+    # the pipeline sits above the cell layer (it imports this package): imported when used
+    from mechc.frontends.boolfile import parse_bool
     from mechc.passes.assemble import MechOptions
     from mechc.pipeline import CompileOptions, compile_netlist
-    from mechc.proofs import ProofSettings, prove
 
-    key = key or (cls.name, cls.source_sha256, type_name, n, repr(sorted(params.items())), stroke)
-    if key in _PROVEN:
-        return list(_PROVEN[key] or [])
-    _PROVEN[key] = None
-    pins = cls.input_names(n)
     nets = [f"i{k}" for k in range(n)]
     table = evaluate_type(type_name, table_rows(n), params, 1 << n)
     on = [str(r) for r in range(1 << n) if table[r]]
@@ -67,11 +62,25 @@ def prove_cell(cls: type[Cell], lib: Library, type_name: str, n: int, params: di
                       f"<cell {cls.name}>")
     nl = Netlist(nets)
     nl.add_cell(CellInst("c1", cls.name, type_name, tuple(nets), ("z",), params),
-                pin_names=pins, out_pins=list(cls.outputs))
+                pin_names=cls.input_names(n), out_pins=list(cls.outputs))
     nl.set_output("z", "z")
+    return compile_netlist(spec, nl, CompileOptions(mech=MechOptions(stroke=stroke)), lib), table
+
+
+def prove_cell(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
+               stroke: float, key: tuple | None = None) -> list[Check]:
+    """The checks of one cell proven alone (cached; [] while its own proof is running, for the
+    one-cell design's design checks come back here)."""
+    from mechc.proofs import ProofSettings, prove  # the pipeline imports this module's users
+
+    key = key or (cls.name, cls.source_sha256, type_name, n, repr(sorted(params.items())), stroke)
+    if key in _PROVEN:
+        return list(_PROVEN[key] or [])
+    _PROVEN[key] = None
+    pins = cls.input_names(n)
     try:
-        alone = compile_netlist(spec, nl, CompileOptions(mech=MechOptions(stroke=stroke)), lib)
-        report = prove(alone, spec, lib, "kinematic", ProofSettings(tolerance=TOLERANCE))
+        design, _ = alone(cls, lib, type_name, n, params, stroke)
+        report = prove(design, design.spec, lib, "kinematic", ProofSettings(tolerance=TOLERANCE))
     except BaseException:
         del _PROVEN[key]
         raise

@@ -95,8 +95,9 @@ def angle_between_lines(ax, ay, bx, by):
 
 # The design checks' angles over all states in the cheap domain: the tangent of the angle
 # (``Poses.transmission`` and ``singular_margin`` store it with ``Angles.set_tan``), from
-# cross and dot products, a square root or a ratio the closed form already has, no trig per
-# state; the check converts only the extreme to degrees (``Angles.min_deg``).
+# cross and dot products or a square root, or a squared distance the closed form already has
+# (``Angles.set_sides``), no trig per state; the check converts only the extreme to degrees
+# (``Angles.min_deg``).
 
 def line_tan(ax, ay, bx, by):
     """tan of the acute angle between direction fields a and b: |a×b| / |a·b| (inf: square;
@@ -116,12 +117,6 @@ def arccos_tan(c):
     c = np.clip(c, 0.0, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.sqrt((1.0 - c) * (1.0 + c)) / c
-
-
-def ratio_tan(y, x):
-    """tan of arctan2(y, x) for y >= 0, x >= 0: y / x (a hot path: call it where division
-    by zero is already silenced)."""
-    return y / x
 
 
 # ---- where a body's points are ----------------------------------------------------------------
@@ -163,24 +158,44 @@ def placed_position(body: Body | None, poses: Poses, p: Point) -> Coords:
     return (hit[0], hit[1]) if hit is not None else position(body, poses, p)
 
 
+def is_zero(v) -> bool:
+    """``v`` is the number 0 (not an array): a term that adds nothing and can be skipped."""
+    return isinstance(v, (float, int)) and v == 0
+
+
+def shifted(a, k):
+    """``a + k``, or ``a`` itself when ``k`` is the number 0 (the same values, one array pass
+    and one allocation fewer; the caller must not write into the result)."""
+    return a if is_zero(k) else a + k
+
+
 def rotate(rx, ry, c, s, centre) -> Coords:
     """centre + R·(rx, ry) for the cosines ``c`` and sines ``s`` of the states: the terms of
-    an arm component that is exactly 0 (a number) are skipped, which gives the same values
-    (an arm along an axis is common: it saves two of the eight array passes)."""
+    an arm component or a centre coordinate that is exactly 0 (a number) are skipped, which
+    gives the same values (an arm along an axis and a pivot on an axis are common: each saves
+    array passes of the eight)."""
     if is_number(rx) and is_number(ry) and (rx == 0 or ry == 0):
         if rx == 0:
-            x, y = ry * s, ry * c
-            np.subtract(centre[0], x, out=x)
+            y = ry * c
+            if is_zero(centre[0]):
+                x = (-ry) * s  # -(ry s): the same value as 0 - ry s
+            else:
+                x = ry * s
+                np.subtract(centre[0], x, out=x)
         else:
             x, y = rx * c, rx * s
-            x += centre[0]
-        y += centre[1]
+            if not is_zero(centre[0]):
+                x += centre[0]
+        if not is_zero(centre[1]):
+            y += centre[1]
         return x, y
     x, y = rx * c, rx * s
     x -= ry * s
     y += ry * c
-    x += centre[0]
-    y += centre[1]
+    if not is_zero(centre[0]):
+        x += centre[0]
+    if not is_zero(centre[1]):
+        y += centre[1]
     return x, y
 
 

@@ -8,6 +8,7 @@ importing each other.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Iterator, MutableMapping
 from dataclasses import dataclass, field
 from typing import Protocol
@@ -21,28 +22,17 @@ class KinematicsError(Exception):
     """The mechanism is not determinate from its geometry (a modelling error, not a state)."""
 
 
-class Angles(MutableMapping):
-    """Angles (degrees, 0..90) per joint over N states, each kept in the domain it was computed
-    in: degrees, or the angle's tangent (:meth:`set_tan`: a ratio of a cross and a dot
-    product, or of a square root and a cosine — no trig per state). Reading an entry gives
-    degrees; a check wants the extreme only, so :meth:`min_deg` takes it in the stored domain
-    (the tangent rises with the angle on 0..90°) and converts that one value."""
+class _Entries(MutableMapping):
+    """A mapping that keeps each entry as it was computed (``_v``) and derives what is read
+    from it; copying from the same kind copies the stored entries, nothing derived."""
 
     def __init__(self, items: dict | None = None):
-        self._v: dict[str, tuple[np.ndarray, bool]] = {}  # joint -> (values, is tangent)
+        self._v: dict = {}
         if items:
             self.update(items)
 
-    def __getitem__(self, key: str) -> np.ndarray:
-        a, tan = self._v[key]
-        return np.degrees(np.arctan(a)) if tan else a
-
-    def __setitem__(self, key: str, degrees: np.ndarray) -> None:
-        self._v[key] = (degrees, False)
-
-    def set_tan(self, key: str, tangent: np.ndarray) -> None:
-        """Store the angle as its tangent (inf: 90°, NaN: undefined, as NaN degrees)."""
-        self._v[key] = (tangent, True)
+    def __contains__(self, key: object) -> bool:
+        return key in self._v
 
     def __delitem__(self, key: str) -> None:
         del self._v[key]
@@ -54,21 +44,115 @@ class Angles(MutableMapping):
         return len(self._v)
 
     def update(self, other=(), **kw) -> None:
-        if isinstance(other, Angles):  # as stored: no conversion
+        if isinstance(other, type(self)):  # as stored: nothing derived
             self._v.update(other._v)
         else:
             super().update(other, **kw)
 
+
+DEG, TAN, SIDES = "deg", "tan", "sides"  # the domains an angle is stored in
+
+
+class Angles(_Entries):
+    """Angles (degrees, 0..90) per joint over N states, each kept in the domain it was computed
+    in: degrees; the angle's tangent (:meth:`set_tan`: a ratio of a cross and a dot product,
+    or of a square root and a cosine); or the squared third side of a triangle of two fixed
+    sides (:meth:`set_sides`: the law of cosines) — no trig per state. Reading an entry gives
+    degrees; a check wants the extreme only, so :meth:`min_deg` takes it in the stored domain
+    and converts that one value."""
+
+    def __getitem__(self, key: str) -> np.ndarray:
+        a, domain, sides = self._v[key]
+        if domain == SIDES:
+            a, domain = sides_tan(a, *sides), TAN
+        return np.degrees(np.arctan(a)) if domain == TAN else a
+
+    def __setitem__(self, key: str, degrees: np.ndarray) -> None:
+        self._v[key] = (degrees, DEG, None)
+
+    def set_tan(self, key: str, tangent: np.ndarray) -> None:
+        """Store the angle as its tangent (inf: 90°, NaN: undefined, as NaN degrees)."""
+        self._v[key] = (tangent, TAN, None)
+
+    def set_sides(self, key: str, d2: np.ndarray, r2, l2) -> None:
+        """Store the acute angle between the sides r and l of a triangle as the square ``d2``
+        of its third side in every state (r², l²: numbers, or arrays of the states): the
+        cosine |r² + l² - d²| / 2rl is linear in d², so the smallest angle is at the smallest
+        or the largest d² and only those two are converted. 0° where the triangle cannot
+        close, NaN where d² is NaN; per state exactly :func:`sides_tan`."""
+        self._v[key] = (d2, SIDES, (r2, l2))
+
     def min_deg(self, key: str) -> float | None:
         """The smallest angle over the states (degrees); NaN if every state is undefined,
         None if there are no states."""
-        a, tan = self._v[key]
+        a, domain, sides = self._v[key]
         if not np.size(a):
             return None
-        if np.isnan(a).all():
+        if domain == SIDES:
+            v = _sides_min_tan(a, *sides)
+            domain = TAN
+        else:
+            v = float(np.fmin.reduce(a, axis=None))  # NaN only if every state is NaN
+        if math.isnan(v):
             return math.nan
-        v = float(np.nanmin(a))
-        return math.degrees(math.atan(v)) if tan else v
+        return math.degrees(math.atan(v)) if domain == TAN else v
+
+
+def sides_tan(d2, r2, l2):
+    """Per state, tan of the acute angle between the sides r and l of a triangle whose third
+    side is d: |arm×rod| / |arm·rod| in units of d² (A = 1/2 + (r² - l²)/2d², H² = r²/d² - A²,
+    the lever-from-rod closed form's numbers): H / |r²/d² - A|, which unlike arccos of the
+    cosine stays accurate near 0°; 0 where the triangle cannot close (H² < 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = np.divide(1.0, d2)
+        A = inv * (0.5 * (r2 - l2))
+        A += 0.5
+        u = inv * r2
+        H = np.sqrt(u - A * A)
+        u -= A
+        return np.fmax(H, 0.0) / np.abs(u)
+
+
+def _sides_min_tan(d2: np.ndarray, r2, l2) -> float:
+    """The smallest of :func:`sides_tan` over the states (NaN if every state is NaN): at the
+    smallest or the largest d² (the angle rises to 90° at d² = r² + l² and falls on both
+    sides, 0 past closing), those two worked out in Python floats (the same IEEE operations
+    as numpy's, so the same values, without a numpy call per operation); every state's where
+    the dimensions vary per state or a d² is 0 (a side of no length, whose angle the closed
+    form leaves undefined or 0 by the sign of r² - l²)."""
+    global _LAST_SIDES
+    if isinstance(r2, (float, int)) and isinstance(l2, (float, int)):
+        last = _LAST_SIDES  # one array serves the transmission and the toggle checks
+        if last[0]() is d2 and last[1] == r2 and last[2] == l2 and not d2.flags.writeable:
+            return last[3]
+        lo = float(np.fmin.reduce(d2, axis=None))
+        if math.isnan(lo):  # every state undefined
+            return math.nan
+        if lo != 0:
+            a = _sides_tan_1(lo, r2, l2)
+            b = _sides_tan_1(float(np.fmax.reduce(d2, axis=None)), r2, l2)
+            v = a if b != b or a <= b else b  # the smaller, NaN passed over (as fmin)
+            _LAST_SIDES = (weakref.ref(d2), r2, l2, v)
+            return v
+    return float(np.fmin.reduce(sides_tan(d2, r2, l2), axis=None))
+
+
+#: the last (d² by weak reference, r², l², smallest tangent) worked out: a read-only d² is not
+#: changed since, and the reference does not keep a proof's chunk alive
+_LAST_SIDES: tuple = (lambda: None, None, None, math.nan)
+
+
+def _sides_tan_1(d2: float, r2: float, l2: float) -> float:
+    """:func:`sides_tan` of one d² > 0 (inf included), operation for operation."""
+    inv = 1.0 / d2
+    A = inv * (0.5 * (r2 - l2)) + 0.5
+    u = inv * r2
+    h2 = u - A * A
+    h = math.sqrt(h2) if h2 > 0 else 0.0  # fmax(NaN, 0): 0 past the toggle
+    w = abs(u - A)
+    if w == 0:
+        return math.inf if h > 0 else math.nan
+    return h / w
 
 
 class Turn:
@@ -115,15 +199,10 @@ class Turn:
         return self._cs
 
 
-class Turns(MutableMapping):
+class Turns(_Entries):
     """Turn angles (rad, ccw from the design pose) per body over N states: reading an entry
     gives the angle; :meth:`cos_sin` gives its cosine and sine the cheapest way the entry
     allows (see :class:`Turn`)."""
-
-    def __init__(self, items: dict | None = None):
-        self._v: dict[str, Turn] = {}
-        if items:
-            self.update(items)
 
     def __getitem__(self, key: str) -> np.ndarray:
         return self._v[key].angle()
@@ -141,24 +220,6 @@ class Turns(MutableMapping):
 
     def cos_sin(self, key: str) -> tuple[np.ndarray, np.ndarray]:
         return self._v[key].cos_sin()
-
-    def __contains__(self, key: object) -> bool:
-        return key in self._v
-
-    def __delitem__(self, key: str) -> None:
-        del self._v[key]
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(self._v)
-
-    def __len__(self) -> int:
-        return len(self._v)
-
-    def update(self, other=(), **kw) -> None:
-        if isinstance(other, Turns):  # as stored: nothing derived
-            self._v.update(other._v)
-        else:
-            super().update(other, **kw)
 
 
 @dataclass

@@ -26,7 +26,7 @@ from mechc.parts.base import (
     placed_key,
     placed_position,
     position,
-    ratio_tan,
+    shifted,
     side_of,
     sized,
 )
@@ -72,45 +72,47 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     A·D ± H·D⊥ from the pivot with A = 1/2 + (r² - L²)/(2d²) and H² = r²/d² - A², so one
     division and one square root place it (the lever keeps the arm as its pose: the arctan2 of
     its angle is taken only if the angle is read, :class:`mechc.parts.poses.Turn`, and the pin
-    is not read back through it); the transmission angle comes from the
-    same numbers (arm·rod = r² - A·d², |arm×rod| = H·d²) as a tangent,
-    which unlike arccos of a cosine stays accurate at the toggle (H -> 0). It is the same
-    circle meeting as :func:`mechc.geometry.circles.circle_meeting`, kept in these units
-    because it is the hot path of every kinematic proof (the transmission angle shares its
-    terms)."""
+    is not read back through it). The transmission angle is kept as d², which it depends on
+    alone (arm, rod and D make a triangle of sides r, L, d): the check converts only the
+    smallest and largest d² of the states, with the tangent H / |r²/d² - A| of the same
+    numbers (:func:`mechc.parts.poses.sides_tan`), which unlike arccos of a cosine stays
+    accurate at the toggle (H -> 0). It is the same circle meeting as
+    :func:`mechc.geometry.circles.circle_meeting`, kept in these units because it is the hot
+    path of every kinematic proof."""
     mine, theirs = (j.pb, j.pa) if j.b == lever.id else (j.pa, j.pb)
     P = lever.pivot
     r2 = (mine[0] - P[0]) ** 2 + (mine[1] - P[1]) ** 2
     L2 = j.length * j.length
     cx, cy = position(other, poses, theirs)
-    dx, dy = cx - P[0], cy - P[1]
+    dx, dy = shifted(cx, -P[0]), shifted(cy, -P[1])  # read only below
+    if not (is_number(P[0]) and is_number(P[1]) and is_number(r2) and is_number(L2)
+            and dx.shape == dy.shape):  # per-sample dimensions: the in-place steps need
+        dx, dy = sized(dx, size), sized(dy, size)  # one shape
     with np.errstate(divide="ignore", invalid="ignore"):  # temporaries reused in place
-        inv = dx * dx
-        inv += dy * dy
-        np.divide(1.0, inv, out=inv)  # d = 0 or NaN: A, H2 NaN below, the state is bad
+        d2 = dx * dx  # kept: the transmission angle's domain
+        H = dy * dy
+        d2 += H
+        inv = np.divide(1.0, d2)  # d = 0 or NaN: A, H2 NaN below, the state is bad
         A = inv * (0.5 * (r2 - L2))
         A += 0.5
-        u = inv * r2  # r²/d²
-        H = A * A
+        u = np.multiply(inv, r2, out=inv)  # r²/d²
+        np.multiply(A, A, out=H)
         np.subtract(u, H, out=H)  # H² = r²/d² - A²
-        ok = H >= 0
-        np.sqrt(H, out=H)  # unsolved states (past the toggle): NaN pin, NaN angle
-        # transmission: angle between the rod and the lever arm (90° is ideal); 0 past the
-        # toggle (fmax takes 0 over H's NaN there); kept as its tangent |arm×rod| / |arm·rod|
-        # with arm·rod = r² - A·d² (the check converts the smallest only)
-        u -= A
-        gamma = ratio_tan(np.fmax(H, 0.0), np.abs(u, out=u))
+        np.sqrt(H, out=H)  # unsolved states (H² < 0, past the toggle, or NaN): NaN
+        bad = np.isnan(H)  # the states that cannot assemble
     side = side_of(cross((theirs[0] - P[0], theirs[1] - P[1]), (mine[0] - P[0], mine[1] - P[1])))
-    rx, ry = A * dx, A * dy
+    rx = A * dx
+    ry = np.multiply(A, dy, out=A)
+    t = u  # a spare temporary from here on
     if not isinstance(side, float):  # dimensions as arrays (a tolerance run): per sample
         rx -= side * H * dy
         ry += side * H * dx
     elif side > 0:
-        rx -= H * dy
-        ry += H * dx
+        rx -= np.multiply(H, dy, out=t)
+        ry += np.multiply(H, dx, out=t)
     else:
-        rx += H * dy
-        ry -= H * dx
+        rx += np.multiply(H, dy, out=t)
+        ry -= np.multiply(H, dx, out=t)
     if rx.shape != (size,):
         rx, ry = (np.broadcast_to(v, (size,)).copy() for v in (rx, ry))
     # the lever's pose is the arm it turned to: its angle (an arctan2) is taken when read
@@ -118,18 +120,24 @@ def lever_from_rod(j: Joint, lever: Body, other: Body | None, poses: Poses,
     phi0 = math.atan2(my, mx) if is_number(mx) and is_number(my) else np.arctan2(my, mx)
     poses.theta.set_arm(lever.id, rx, ry, mx, my, phi0)
     other_bad = poses.bad.get(other.id if other else GROUND)
-    bad = ~sized(ok, size)
+    if bad.shape != (size,):
+        bad = np.broadcast_to(bad, (size,)).copy()
     if other_bad is not None:
         bad |= other_bad
     poses.mark(lever.id, bad, own=True)
-    poses.placed[placed_key(lever, mine)] = (rx + P[0], ry + P[1],
+    poses.placed[placed_key(lever, mine)] = (shifted(rx, P[0]), shifted(ry, P[1]),
                                              poses.theta.entry(lever.id))
     if other is not None:
         poses.placed[placed_key(other, theirs)] = (cx, cy, poses.theta.entry(other.id))
-    if gamma.shape != (size,):
-        gamma = np.broadcast_to(gamma, (size,)).copy()
-    poses.transmission.set_tan(j.id, gamma)  # read-only from here on: one array serves both
-    poses.singular_margin.set_tan(j.id, gamma)
+    # transmission: the angle between the rod and the lever arm (90° is ideal), 0 past the
+    # toggle; kept as d² (arm, rod and d make a triangle: the law of cosines), converted at
+    # the extreme only (``Angles.set_sides``)
+    if d2.shape == (size,):
+        d2.flags.writeable = False  # one array serves both checks, unchanged from here on
+    else:
+        d2 = sized(d2, size)  # a read-only view
+    poses.transmission.set_sides(j.id, d2, r2, L2)
+    poses.singular_margin.set_sides(j.id, d2, r2, L2)
 
 
 class Rod(JointKind):
@@ -139,19 +147,28 @@ class Rod(JointKind):
 
     @classmethod
     def violation(cls, j: Joint, a: Body | None, b: Body | None, poses: Poses, size: int,
-                  tol: float) -> np.ndarray:
-        """|distance - length| > 1e-6, squared: no square root."""
+                  tol: float) -> np.ndarray | None:
+        """|distance - length| > 1e-6, squared: no square root. The smallest and largest
+        squared distance decide first: when both are in the band no state breaks the rod
+        (None: nothing to mark), and the states are compared one by one only otherwise."""
         ax_, ay_ = placed_position(a, poses, j.pa)
         bx_, by_ = placed_position(b, poses, j.pb)
         g2, ey = bx_ - ax_, by_ - ay_  # the differences are temporaries: squared in place
         g2 *= g2
         ey *= ey
         g2 += ey
-        viol = g2 > (j.length + 1e-6) ** 2
-        if not is_number(j.length):  # a length per sample (a tolerance run)
+        hi2 = (j.length + 1e-6) ** 2
+        if is_number(j.length):
+            lo2 = (j.length - 1e-6) ** 2 if j.length > 1e-6 else -math.inf
+            # NaN states (not placed) break nothing, here as below: fmin/fmax pass them over
+            if (g2.size and np.fmax.reduce(g2, axis=None) <= hi2
+                    and np.fmin.reduce(g2, axis=None) >= lo2):
+                return None
+            viol = g2 > hi2
+            viol |= g2 < lo2
+        else:  # a length per sample (a tolerance run)
+            viol = g2 > hi2
             viol |= (j.length > 1e-6) & (g2 < (j.length - 1e-6) ** 2)
-        elif j.length > 1e-6:
-            viol |= g2 < (j.length - 1e-6) ** 2
         return sized(viol, size)
 
     @classmethod
