@@ -25,6 +25,7 @@ from mechc.passes.amplify import (
     amplify_nets,
     nets_overstressed,
     nets_short_of_force,
+    plan_force_amplifiers,
     snap_outputs,
 )
 from mechc.passes.assemble import MechOptions, assemble_mechanism
@@ -258,6 +259,14 @@ def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
     and synthesise again. Returns the (possibly amplified) netlist, its layout and mechanism,
     and net -> reason for every net amplified."""
     amps: dict[str, str] = {}
+    if opts.amplify and not nl.state_nets():
+        # combinational: amplifiers where the force budget needs them, in one sweep back from
+        # the outputs; the rounds below only mend what the assembled checks still find
+        planned = plan_force_amplifiers(nl, lib, opts.mech)
+        if planned:
+            amps.update(planned)
+            nl = amplify_nets(nl, lib, planned)
+            layout = None
     for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
         if layout is None or attempt:
             layout = place(nl)

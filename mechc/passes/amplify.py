@@ -25,8 +25,10 @@ import networkx as nx
 
 from mechc.cells.library import Library
 from mechc.errors import DesignError
+from mechc.ir.mechanism import Demand
 from mechc.ir.netlist import CellInst, Netlist
-from mechc.passes.strength import strength_checks
+from mechc.passes.assemble import MechOptions, synth_context
+from mechc.passes.strength import cell_holds, strength_checks
 
 #: Used when the library's AMPLIFIER does not state how many loads it may drive.
 DEFAULT_FANOUT = 2
@@ -99,20 +101,108 @@ def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
     reach = _memories_reached(nl)
     extra: list[CellInst] = []
     for net in nets:
-        # loads that feed the same MEMORY share an amplifier where they can: two amplifiers
-        # never switch at quite the same moment, and a skew between a memory's SET and RESET
-        # paths is the overlap of Appendix B.2
-        ls = sorted(loads.get(net, []), key=lambda load: (reach.get(load[0], ()), load))
-        for g in range(0, len(ls), limit):
+        for group in _groups(loads.get(net, []), reach, limit):
             new = _fresh(f"{net}_amp", names)
             extra.append(CellInst(_fresh("a", names), amp.name, "AMPLIFIER", (net,), (new,),
                                   {"reason": reason}))
-            for cid, k in ls[g:g + limit]:
+            for cid, k in group:
                 c = cells[cid]
                 ins = list(c.inputs)
                 ins[k] = new
                 cells[cid] = CellInst(c.id, c.cell, c.type, tuple(ins), c.outputs, c.params)
     return _rebuild(nl, lib, list(cells.values()) + extra, dict(nl.outputs))
+
+
+def _groups(ls: list[tuple[str, int]], reach: dict[str, tuple[str, ...]],
+            limit: int) -> list[list[tuple[str, int]]]:
+    """A net's loads (cell, pin) in the groups that share one amplifier: at most ``limit``
+    each; loads that feed the same MEMORY together where they can (two amplifiers never
+    switch at quite the same moment, and a skew between a memory's SET and RESET paths is the
+    overlap of Appendix B.2)."""
+    ls = sorted(ls, key=lambda load: (reach.get(load[0], ()), load))
+    return [ls[g:g + limit] for g in range(0, len(ls), limit)]
+
+
+def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions) -> dict[str, str]:
+    """Nets to amplify so that every cell can drive what it must, chosen in one sweep of the
+    force budget from the outputs back (combinational netlists).
+
+    A cell's demand is what its output net's loads ask; each level multiplies it (a spring
+    preloaded 1.3x what it moves, rising 30 % over the stroke, is what the next cell back must
+    overcome), so in a deep chain it grows until some part yields. Sweeping back, each cell is
+    synthesised for its net's demand; where the cell alone fails a strength check under that
+    load (``strength.cell_holds``), or an input actuator would need more than its rating, that
+    net goes behind amplifiers (their inputs ask only slider friction), which resets the
+    demand seen further back. An amplifier is put in only where a cell cannot do without one,
+    as far back as it can be, so one amplifier relieves as many levels as the parts allow."""
+    ctx = synth_context(opts)
+    limit = fanout_limit(lib)
+    amp = amplifier_cell(lib)
+    reach = _memories_reached(nl)
+    loads: dict[str, list[tuple[str, int]]] = {}
+    for c in nl.cells.values():
+        if c.type != "AMPLIFIER":
+            for k, net in enumerate(c.inputs):
+                loads.setdefault(net, []).append((c.id, k))
+    ask: dict[tuple[str, int], Demand] = {}  # (cell, pin) -> what it asks, friction included
+    base: dict[str, Demand] = {}  # net -> demand of what stays on it if amplified
+    for net in nl.outputs.values():
+        base[net] = Demand(opts.output_load, opts.output_load)
+    for c in nl.cells.values():
+        if c.type == "AMPLIFIER":
+            a = _asks(amp, c, ctx, Demand())
+            base[c.inputs[0]] = base.get(c.inputs[0], Demand()) + a[0]
+    out: dict[str, str] = {}
+
+    def demand_of(net: str) -> Demand:
+        d = base.get(net, Demand())
+        for load in loads.get(net, []):
+            d = d + ask[load]
+        return d
+
+    def amplified(net: str) -> Demand:
+        d = base.get(net, Demand())
+        for group in _groups(loads.get(net, []), reach, limit):
+            own = Demand()
+            for load in group:
+                own = own + ask[load]
+            d = d + _asks(amp, None, ctx, own)[0]
+        return d
+
+    state = nl.state_nets()
+    for cell in reversed(nl.topo_cells()):
+        net = cell.outputs[0]
+        d = demand_of(net)
+        asks = _asks(lib[cell.cell], cell, ctx, d, check=True)
+        if asks is None and loads.get(net) and net not in state:
+            out[net] = f"force: {cell.id} ({cell.type}) cannot drive its loads' demand"
+            d = amplified(net)
+            asks = _asks(lib[cell.cell], cell, ctx, d)
+        for k, a in enumerate(asks or _asks(lib[cell.cell], cell, ctx, d)):
+            ask[(cell.id, k)] = a
+    for net in nl.inputs:
+        d = demand_of(net)
+        if max(d.right, d.left) + ctx.friction > opts.actuator_force and loads.get(net):
+            out[net] = "force: its actuator would be asked more than its rating"
+    return out
+
+
+def _asks(cls, cell: CellInst | None, ctx, demand: Demand,
+          check: bool = False) -> list[Demand] | None:
+    """What each input of ``cell`` (an instance of ``cls``) asks of its net, guide friction
+    included, when it must deliver ``demand``; ``check``: None if the cell alone then fails
+    a strength check."""
+    n = len(cell.inputs) if cell is not None else 1
+    part = cls.synthesise(cell.id if cell else "amp", ctx, n, dict(cell.params) if cell else {},
+                          demand)
+    pins = cls.input_names(n)
+    asks = [Demand(part.data["input_loads"][p]["right_N"] + ctx.friction,
+                   part.data["input_loads"][p]["left_N"] + ctx.friction) for p in pins]
+    if check:
+        load = max([demand.right, demand.left] + [max(a.right, a.left) for a in asks])
+        if not cell_holds(cell.id, part, load, ctx):
+            return None
+    return asks
 
 
 def nets_short_of_force(nl: Netlist, mech, lib: Library) -> dict[str, str]:

@@ -25,6 +25,7 @@ from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube
 from mechc.logic.yosys import run_yosys
 from mechc.passes.factor import factored_netlist
+from mechc.passes.hazard_cure import cure_hazards
 from mechc.passes.map import map_equations
 from mechc.passes.map_sop import MapOptions
 from mechc.passes.minimise import MinimiseOptions, minimise
@@ -188,12 +189,18 @@ def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
     tried: dict[str, int] = {}
     for c in cands:
         bad = static_hazards(c.netlist)
-        if bad and two_level is not None:
-            c.netlist = with_two_level(c.netlist, two_level, sorted(bad))
+        if bad:
+            fixes = []
+            if two_level is not None:
+                fixes.append(with_two_level(c.netlist, two_level, sorted(bad)))
+            cured = cure_hazards(c.netlist, sorted(bad), library, map_opts)
+            if cured is not None and not static_hazards(cured):
+                fixes.append(cured)
+            if not fixes:
+                continue
+            c.netlist = min(fixes, key=lambda nl: _parts(nl, library))
             c.parts = _parts(c.netlist, library)
             c.two_level_outputs = sorted(bad)
-        elif bad:
-            continue
         tried[c.script] = c.parts
         if best is None or c.parts < best.parts:
             best = c
