@@ -262,10 +262,10 @@ def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
     if opts.amplify and not nl.state_nets():
         # combinational: amplifiers where the force budget needs them, in one sweep back from
         # the outputs; the rounds below only mend what the assembled checks still find
-        planned = plan_force_amplifiers(nl, lib, opts.mech)
+        planned, groups = plan_force_amplifiers(nl, lib, opts.mech)
         if planned:
             amps.update(planned)
-            nl = amplify_nets(nl, lib, planned)
+            nl = amplify_nets(nl, lib, planned, groups=groups)
             layout = None
     for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
         if layout is None or attempt:

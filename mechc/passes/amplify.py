@@ -19,16 +19,17 @@ Both are plain functions ``Netlist -> Netlist``; the pipeline decides where.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
 import networkx as nx
 
 from mechc.cells.library import Library
 from mechc.errors import DesignError
-from mechc.ir.mechanism import Demand
+from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.passes.assemble import MechOptions, synth_context
-from mechc.passes.strength import cell_holds, strength_checks
+from mechc.passes.strength import cell_holds, force_ceiling, strength_checks
 
 #: Used when the library's AMPLIFIER does not state how many loads it may drive.
 DEFAULT_FANOUT = 2
@@ -83,11 +84,12 @@ def snap_outputs(nl: Netlist, lib: Library, outputs: Iterable[str]) -> Netlist:
     return _rebuild(nl, lib, cells, outs)
 
 
-def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
-                 reason: str = "force") -> Netlist:
+def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str], reason: str = "force",
+                 groups: dict[str, list[list[tuple[str, int]]]] | None = None) -> Netlist:
     """Every load of each named net moves behind AMPLIFIERs, at most the measured fan-out per
-    amplifier; primary outputs on the net stay on it (their load is small). ``reason`` is
-    recorded in each new cell's params (force, or a feedback delay)."""
+    amplifier (or in the ``groups`` given for it: lists of (cell, input index)); primary
+    outputs on the net stay on it (their load is small). ``reason`` is recorded in each new
+    cell's params (force, or a feedback delay)."""
     amp = amplifier_cell(lib)
     limit = fanout_limit(lib)
     names = _names(nl)
@@ -101,7 +103,7 @@ def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
     reach = _memories_reached(nl)
     extra: list[CellInst] = []
     for net in nets:
-        for group in _groups(loads.get(net, []), reach, limit):
+        for group in (groups or {}).get(net) or _groups(loads.get(net, []), reach, limit):
             new = _fresh(f"{net}_amp", names)
             extra.append(CellInst(_fresh("a", names), amp.name, "AMPLIFIER", (net,), (new,),
                                   {"reason": reason}))
@@ -113,17 +115,45 @@ def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
     return _rebuild(nl, lib, list(cells.values()) + extra, dict(nl.outputs))
 
 
-def _groups(ls: list[tuple[str, int]], reach: dict[str, tuple[str, ...]],
-            limit: int) -> list[list[tuple[str, int]]]:
+def _groups(ls: list[tuple[str, int]], reach: dict[str, tuple[str, ...]], limit: int,
+            ask: dict[tuple[str, int], Demand] | None = None,
+            cap: float = math.inf) -> list[list[tuple[str, int]]]:
     """A net's loads (cell, pin) in the groups that share one amplifier: at most ``limit``
-    each; loads that feed the same MEMORY together where they can (two amplifiers never
-    switch at quite the same moment, and a skew between a memory's SET and RESET paths is the
-    overlap of Appendix B.2)."""
+    each and, given what each asks, at most ``cap`` newtons each way; loads that feed the
+    same MEMORY together where they can (two amplifiers never switch at quite the same
+    moment, and a skew between a memory's SET and RESET paths is the overlap of Appendix
+    B.2)."""
     ls = sorted(ls, key=lambda load: (reach.get(load[0], ()), load))
-    return [ls[g:g + limit] for g in range(0, len(ls), limit)]
+    out: list[list[tuple[str, int]]] = []
+    total = Demand()
+    for load in ls:
+        a = ask[load] if ask is not None else Demand()
+        more = total + a
+        if not out or len(out[-1]) >= limit or max(more.right, more.left) > cap:
+            out.append([])
+            more = a
+        out[-1].append(load)
+        total = more
+    return out
 
 
-def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions) -> dict[str, str]:
+def amplifier_capacity(lib: Library, ctx: SynthContext) -> float:
+    """The largest demand (N, each way) an AMPLIFIER's output can move with every part of
+    it within its strength checks (bisection: the checks only get worse with the load)."""
+    amp = amplifier_cell(lib)
+    lo, hi = 0.0, force_ceiling(ctx)
+    for _ in range(40):
+        mid = (lo + hi) / 2
+        try:
+            ok = _asks(amp, None, ctx, Demand(mid, mid), check=True) is not None
+        except DesignError:
+            ok = False
+        lo, hi = (mid, hi) if ok else (lo, mid)
+    return lo
+
+
+def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions
+                          ) -> tuple[dict[str, str], dict[str, list[list[tuple[str, int]]]]]:
     """Nets to amplify so that every cell can drive what it must, chosen in one sweep of the
     force budget from the outputs back (combinational netlists).
 
@@ -134,9 +164,13 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions) -> dict[
     load (``strength.cell_holds``), or an input actuator would need more than its rating, that
     net goes behind amplifiers (their inputs ask only slider friction), which resets the
     demand seen further back. An amplifier is put in only where a cell cannot do without one,
-    as far back as it can be, so one amplifier relieves as many levels as the parts allow."""
+    as far back as it can be, so one amplifier relieves as many levels as the parts allow.
+    An amplifier moves at most :func:`amplifier_capacity`, so a cell that would ask more than
+    that of one input is relieved too, and a net's loads are grouped by force as well as by
+    count. Returns net -> reason and net -> its groups of loads (for :func:`amplify_nets`)."""
     ctx = synth_context(opts)
     limit = fanout_limit(lib)
+    cap = amplifier_capacity(lib, ctx)
     amp = amplifier_cell(lib)
     reach = _memories_reached(nl)
     loads: dict[str, list[tuple[str, int]]] = {}
@@ -160,9 +194,12 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions) -> dict[
             d = d + ask[load]
         return d
 
+    groups: dict[str, list[list[tuple[str, int]]]] = {}
+
     def amplified(net: str) -> Demand:
         d = base.get(net, Demand())
-        for group in _groups(loads.get(net, []), reach, limit):
+        groups[net] = _groups(loads.get(net, []), reach, limit, ask, cap)
+        for group in groups[net]:
             own = Demand()
             for load in group:
                 own = own + ask[load]
@@ -174,7 +211,8 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions) -> dict[
         net = cell.outputs[0]
         d = demand_of(net)
         asks = _asks(lib[cell.cell], cell, ctx, d, check=True)
-        if asks is None and loads.get(net) and net not in state:
+        heavy = asks is None or max(max(a.right, a.left) for a in asks) > cap
+        if heavy and loads.get(net) and net not in state:
             out[net] = f"force: {cell.id} ({cell.type}) cannot drive its loads' demand"
             d = amplified(net)
             asks = _asks(lib[cell.cell], cell, ctx, d)
@@ -184,7 +222,8 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions) -> dict[
         d = demand_of(net)
         if max(d.right, d.left) + ctx.friction > opts.actuator_force and loads.get(net):
             out[net] = "force: its actuator would be asked more than its rating"
-    return out
+            amplified(net)
+    return out, groups
 
 
 def _asks(cls, cell: CellInst | None, ctx, demand: Demand,
@@ -200,7 +239,7 @@ def _asks(cls, cell: CellInst | None, ctx, demand: Demand,
                    part.data["input_loads"][p]["left_N"] + ctx.friction) for p in pins]
     if check:
         load = max([demand.right, demand.left] + [max(a.right, a.left) for a in asks])
-        if not cell_holds(cell.id, part, load, ctx):
+        if not cell_holds(cell.id if cell else "amp", part, load, ctx):
             return None
     return asks
 

@@ -93,37 +93,74 @@ def cover_changes(on: np.ndarray, moves: np.ndarray, starts: np.ndarray, n: int)
 def cure_hazards(nl: Netlist, outputs: list[str], library: Library,
                  opts: MapOptions) -> Netlist | None:
     """``nl`` with each named output's static hazards cured by cubes (module docstring);
-    None where the network is too wide to enumerate its changes."""
+    None where the network is too wide to enumerate its changes. The outputs are cured in
+    the order of their depth, and a cured output also replaces its net wherever the network
+    uses it (an equivalent net that is X on fewer changes: ternary simulation is monotone, so
+    what depends on it can only glitch less, and the AND of cured bits needs fewer cubes)."""
     n = len(nl.inputs)
     if n > MAX_EXHAUSTIVE_INPUTS:
         return None
     bits = input_matrix(n)
-    values = nl.evaluate({x: bits[i] for i, x in enumerate(nl.inputs)})
-    found = hazard_transitions(nl)
-    keys = netlist_keys(nl)
     pl = Planner(library, opts.fan_in, tuple(opts.prefer))
+    depth = nl.depth()
+    order = sorted((o for o in outputs if nl.outputs[o] in nl.driver
+                    and nl.driver[nl.outputs[o]][0] in nl.cells),
+                   key=lambda o: (depth[nl.driver[nl.outputs[o]][0]], o))
+    for o in order:
+        found = hazard_transitions(nl).get(o)
+        keys = netlist_keys(nl)
+        old = keys[nl.outputs[o]]
+        if not found or old[0] in ("in", "CONST"):
+            continue
+        f = nl.evaluate({x: bits[i] for i, x in enumerate(nl.inputs)})[nl.outputs[o]]
+        new = _cured(pl, old, f, found, list(nl.inputs))
+        memo: dict[Key, Key] = {old: new}
+        roots = {p: (new if p == o else _subst(keys[net], memo))
+                 for p, net in nl.outputs.items()}
+        nl = _materialise(roots, SimpleNamespace(inputs=list(nl.inputs)), library,
+                          tuple(opts.prefer))
+    return nl
+
+
+def _cured(pl: Planner, key: Key, f: np.ndarray, found: list[tuple[int, np.ndarray]],
+           inputs: list[str]) -> Key:
+    """``key`` (truth table ``f``) with the changes ``found`` cured: AND-NOT the cubes of
+    the static-0 ones, OR the cubes of the static-1 ones."""
+    n = len(inputs)
     minterm = (1 << np.arange(n - 1, -1, -1, dtype=np.int64))
-    roots: dict[str, Key] = {}
-    for o, net in nl.outputs.items():
-        key = keys[net]
-        if o in outputs and o in found and key[0] not in ("in", "CONST"):
-            f = values[net]
-            moves, starts = [], []
-            for k, vecs in found[o]:
-                m = minterm @ vecs.astype(np.int64)
-                moves.append(np.full(len(m), 1 << (n - 1 - k), dtype=np.int64))
-                starts.append(m)
-            mv, st = np.concatenate(moves), np.concatenate(starts)
-            high = f[st]
-            for want, cubes_on in ((False, ~f), (True, f)):
-                sel = high == want
-                if not sel.any():
-                    continue
-                cubes = cover_changes(cubes_on, mv[sel], st[sel], n)
-                term = factored_sum(pl, [frozenset(c.literal_list(n)) for c in cubes],
-                                    list(nl.inputs))
-                key = (pl.or_([key, term], []) if want
-                       else pl.gate("AND_NOT", [key, term]))
-        roots[o] = key
-    return _materialise(roots, SimpleNamespace(inputs=list(nl.inputs)), library,
-                        tuple(opts.prefer))
+    moves, starts = [], []
+    for k, vecs in found:
+        m = minterm @ vecs.astype(np.int64)
+        moves.append(np.full(len(m), 1 << (n - 1 - k), dtype=np.int64))
+        starts.append(m)
+    mv, st = np.concatenate(moves), np.concatenate(starts)
+    high = f[st]
+    for want, on in ((False, ~f), (True, f)):
+        sel = high == want
+        if not sel.any():
+            continue
+        cubes = cover_changes(on, mv[sel], st[sel], n)
+        term = factored_sum(pl, [frozenset(c.literal_list(n)) for c in cubes], inputs)
+        key = pl.or_([key, term], []) if want else pl.gate("AND_NOT", [key, term])
+    return key
+
+
+def _subst(key: Key, memo: dict[Key, Key]) -> Key:
+    """``key`` with every sub-structure in ``memo`` replaced (iteratively: chains are deep)."""
+    stack = [key]
+    while stack:
+        k = stack[-1]
+        if k in memo:
+            stack.pop()
+            continue
+        if k[0] in ("in", "CONST"):
+            memo[k] = k
+            stack.pop()
+            continue
+        todo = [c for c in k[1] if c not in memo]
+        if todo:
+            stack.extend(todo)
+            continue
+        stack.pop()
+        memo[k] = (k[0], tuple(memo[c] for c in k[1]))
+    return memo[key]

@@ -146,7 +146,7 @@ def map_multilevel(blif: str, inputs: list[str], outputs: list[str], library: Li
 
 
 #: Cut sizes tried for the hazard-free composition (each node a function of at most K nets).
-LUT_SIZES = (3, 4)
+LUT_SIZES = (3, 4, 6)
 
 
 def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
