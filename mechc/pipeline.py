@@ -139,7 +139,8 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
         built["multi"] = (*stage("assemble", assemble_powered, ml.netlist, lib, opts, layout),
                           Mapped(ml.netlist, ml.implemented))
         info = {"from": source, "method": ml.script, "mapped_parts": ml.parts,
-                "tried": ml.tried, "two_level_outputs": ml.two_level_outputs}
+                "tried": ml.tried, "two_level_outputs": ml.two_level_outputs,
+                "cured_outputs": ml.cured_outputs}
     parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
     two_mapped = netlist_parts(mapped.netlist, lib)
     two_level = "assembled"

@@ -211,7 +211,7 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions
         net = cell.outputs[0]
         d = demand_of(net)
         asks = _asks(lib[cell.cell], cell, ctx, d, check=True)
-        heavy = asks is None or max(max(a.right, a.left) for a in asks) > cap
+        heavy = asks is None or max((max(a.right, a.left) for a in asks), default=0.0) > cap
         if heavy and loads.get(net) and net not in state:
             out[net] = f"force: {cell.id} ({cell.type}) cannot drive its loads' demand"
             d = amplified(net)
