@@ -167,7 +167,10 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions
     as far back as it can be, so one amplifier relieves as many levels as the parts allow.
     An amplifier moves at most :func:`amplifier_capacity`, so a cell that would ask more than
     that of one input is relieved too, and a net's loads are grouped by force as well as by
-    count. Returns net -> reason and net -> its groups of loads (for :func:`amplify_nets`)."""
+    count. Only the heaviest loads of a net go behind amplifiers, as many as its driver needs;
+    in a combinational network a delay on some paths and not others changes no settled value
+    and no ternary (hazard) result, and the kinematic proof checks the design as built.
+    Returns net -> reason and net -> its groups of loads (for :func:`amplify_nets`)."""
     ctx = synth_context(opts)
     limit = fanout_limit(lib)
     cap = amplifier_capacity(lib, ctx)
@@ -196,33 +199,55 @@ def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions
 
     groups: dict[str, list[list[tuple[str, int]]]] = {}
 
-    def amplified(net: str) -> Demand:
-        d = base.get(net, Demand())
-        groups[net] = _groups(loads.get(net, []), reach, limit, ask, cap)
-        for group in groups[net]:
-            own = Demand()
-            for load in group:
-                own = own + ask[load]
-            d = d + _asks(amp, None, ctx, own)[0]
+    def amplified(net: str, fits) -> Demand:
+        """Put the heaviest loads of ``net`` behind amplifiers, as few as leave a demand its
+        driver ``fits`` (all of them if none does); the lightest stay on the net."""
+        ls = sorted(loads.get(net, []), key=lambda load: (max(ask[load].right,
+                                                                ask[load].left), load))
+
+        def split(k: int) -> tuple[Demand, list[list[tuple[str, int]]]]:
+            d = base.get(net, Demand())
+            for load in ls[:k]:
+                d = d + ask[load]
+            gs = _groups(ls[k:], reach, limit, ask, cap)
+            for group in gs:
+                own = Demand()
+                for load in group:
+                    own = own + ask[load]
+                d = d + _asks(amp, None, ctx, own)[0]
+            return d, gs
+
+        lo, hi = 0, len(ls) - 1  # the most loads kept direct: bisection (fewer weigh less)
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            lo, hi = (mid, hi) if fits(split(mid)[0]) else (lo, mid - 1)
+        d, groups[net] = split(lo)
         return d
 
     state = nl.state_nets()
     for cell in reversed(nl.topo_cells()):
         net = cell.outputs[0]
+        cls = lib[cell.cell]
+
+        def fits(d: Demand, cell=cell, cls=cls) -> bool:
+            asks = _asks(cls, cell, ctx, d, check=True)
+            return asks is not None and max((max(a.right, a.left) for a in asks),
+                                            default=0.0) <= cap
+
         d = demand_of(net)
-        asks = _asks(lib[cell.cell], cell, ctx, d, check=True)
-        heavy = asks is None or max((max(a.right, a.left) for a in asks), default=0.0) > cap
-        if heavy and loads.get(net) and net not in state:
+        if not fits(d) and loads.get(net) and net not in state:
             out[net] = f"force: {cell.id} ({cell.type}) cannot drive its loads' demand"
-            d = amplified(net)
-            asks = _asks(lib[cell.cell], cell, ctx, d)
-        for k, a in enumerate(asks or _asks(lib[cell.cell], cell, ctx, d)):
+            d = amplified(net, fits)
+        for k, a in enumerate(_asks(cls, cell, ctx, d)):
             ask[(cell.id, k)] = a
+
+    def actuator_fits(d: Demand) -> bool:
+        return max(d.right, d.left) + ctx.friction <= opts.actuator_force
+
     for net in nl.inputs:
-        d = demand_of(net)
-        if max(d.right, d.left) + ctx.friction > opts.actuator_force and loads.get(net):
+        if not actuator_fits(demand_of(net)) and loads.get(net):
             out[net] = "force: its actuator would be asked more than its rating"
-            amplified(net)
+            amplified(net, actuator_fits)
     return out, groups
 
 
