@@ -71,8 +71,11 @@ def _generic(type_name: str, ins: list[Tern], params: dict) -> Tern:
 def evaluate3(nl: Netlist, values: dict[str, Tern]) -> dict[str, Tern]:
     """Every net's ternary value for the input vectors in ``values``."""
     nets = dict(values)
+    size = len(next(iter(values.values()))[0]) if values else 1
     for cell in nl.topo_cells():
         out = _cell3(cell.type, [nets[n] for n in cell.inputs], cell.params)
+        if not cell.inputs:  # a constant: one value, for every vector
+            out = (np.broadcast_to(out[0], size).copy(), np.broadcast_to(out[1], size).copy())
         for net in cell.outputs:
             nets[net] = out
     return nets
