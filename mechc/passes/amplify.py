@@ -6,8 +6,12 @@ Two reasons, both from ``001_…`` §2.6 and Appendix B:
   than its rating, a MEMORY loop whose force demand grows every time round) gets its loads
   split into groups of at most ``Amplifier.fanout_max`` loads, each group behind its own
   AMPLIFIER; the amplifier's input costs only its slider's friction, its output comes from the
-  motor. Every load of the net moves behind an amplifier, so all its paths keep the same delay
-  (a delay on one path only is the SET/RESET overlap of Appendix B.2).
+  motor. In a sequential netlist every load of the net moves behind an amplifier, so all its
+  paths keep the same delay (a delay on one path only is the SET/RESET overlap of Appendix
+  B.2). A combinational netlist gets its force amplifiers planned in one sweep of the force
+  budget from the outputs back (``plan_force_amplifiers``): a net is amplified only where its
+  driver (a cell under its strength checks, an actuator under its rating) cannot move it, and
+  then only its heaviest loads, grouped within the amplifier's own capacity.
 - **snap** — an output that must hold while an input travels but whose generator moves partway
   because a MEMORY switches before that input has finished its stroke (the output is X in the
   ternary analysis with the memories free to switch). The AMPLIFIER's bistable toggle switches
