@@ -25,6 +25,7 @@ from mechc.passes.amplify import (
     amplify_nets,
     nets_overstressed,
     nets_short_of_force,
+    plan_force_amplifiers,
     snap_outputs,
 )
 from mechc.passes.assemble import MechOptions, assemble_mechanism
@@ -138,7 +139,8 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
         built["multi"] = (*stage("assemble", assemble_powered, ml.netlist, lib, opts, layout),
                           Mapped(ml.netlist, ml.implemented))
         info = {"from": source, "method": ml.script, "mapped_parts": ml.parts,
-                "tried": ml.tried, "two_level_outputs": ml.two_level_outputs}
+                "tried": ml.tried, "two_level_outputs": ml.two_level_outputs,
+                "cured_outputs": ml.cured_outputs}
     parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
     two_mapped = netlist_parts(mapped.netlist, lib)
     two_level = "assembled"
@@ -258,6 +260,14 @@ def assemble_powered(nl: Netlist, lib: Library, opts: CompileOptions,
     and synthesise again. Returns the (possibly amplified) netlist, its layout and mechanism,
     and net -> reason for every net amplified."""
     amps: dict[str, str] = {}
+    if opts.amplify and not nl.state_nets():
+        # combinational: amplifiers where the force budget needs them, in one sweep back from
+        # the outputs; the rounds below only mend what the assembled checks still find
+        planned, groups = plan_force_amplifiers(nl, lib, opts.mech)
+        if planned:
+            amps.update(planned)
+            nl = amplify_nets(nl, lib, planned, groups=groups)
+            layout = None
     for attempt in range(MAX_AMPLIFY_ROUNDS + 1):
         if layout is None or attempt:
             layout = place(nl)

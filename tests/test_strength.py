@@ -81,15 +81,17 @@ def test_axial_stress_and_pins_by_hand(sorter):
 
 
 def test_lever_bending_by_hand(sorter):
-    """A NOT lever of arm 1.5 x stroke = 30 mm under its cell's load F (the largest demand of
-    the nets it drives or loads, or its own output demand): sigma = M / Z = F 30 / (3 x 6^2 / 6)."""
+    """A NOT lever of arm 1.5 x stroke = 30 mm under its cell's load F (the largest of its own
+    output demand, the demand of the net it drives and what each of its inputs asks of the
+    net it loads, guide friction included): sigma = M / Z = F 30 / (3 x 6^2 / 6)."""
     mech = sorter.mechanism
     (c,) = [c for c in checks_named(sorter, "lever bending") if c.where == "c5.lever"]
-    nets = [n for n in mech.nets.values()
-            if n.data["driver"] == "c5" or any(x.startswith("c5.") for x in n.data["loads"])]
-    loads = [max(n.data["demand"]["right_N"], n.data["demand"]["left_N"]) for n in nets]
+    driven = [max(n.data["demand"]["right_N"], n.data["demand"]["left_N"])
+              for n in mech.nets.values() if n.data["driver"] == "c5"]
+    asks = [max(a["right_N"], a["left_N"]) + 0.02
+            for a in mech.cells["c5"].data["input_loads"].values()]
     own = mech.cells["c5"].data["output_demand"]
-    f = max(loads + [own["right_N"], own["left_N"]])
+    f = max(driven + asks + [own["right_N"], own["left_N"]])
     assert c.value == pytest.approx(f * 30.0 / (3.0 * 6.0 ** 2 / 6.0), rel=1e-9)
     assert "30 mm arm" in c.name and c.limit == pytest.approx(138.0)
 
@@ -266,3 +268,32 @@ def test_amplifier_input_resting_short_fails_the_engage_check():
             run_design_checks(design, LIB)
         (c,) = [c for c in design.mechanism.checks if "short of its end" in c.name]
         assert c.value == pytest.approx(extra, abs=1e-6) and c.passed is ok
+
+
+def test_a_load_cell_carries_its_own_rod_not_the_whole_net():
+    """One input drives three OR gates (each with an input of its own, each an output at the
+    default 0.5 N): by the closed-form spring budget each OR input asks 1.3 x 1.3 x (0.5 +
+    0.02) + 0.5 + 0.02 N, plus 0.02 N of rod guide friction; the shared net carries three of
+    those, but each OR cell only its own rod's pull (static force balance on its input
+    slider), so its design load is one share, not the net's demand."""
+    from mechc.frontends.boolfile import parse_bool
+    from mechc.ir.netlist import CellInst, Netlist
+    from mechc.passes.strength import part_loads
+    from mechc.pipeline import compile_netlist
+    nl = Netlist(["a", "b1", "b2", "b3"])
+    cls = LIB.for_type("OR", 2)
+    for k in (1, 2, 3):
+        nl.add_cell(CellInst(f"c{k}", cls.name, "OR", ("a", f"b{k}"), (f"z{k}",)),
+                    pin_names=cls.input_names(2), out_pins=list(cls.outputs))
+        nl.set_output(f"z{k}", f"z{k}")
+    spec = parse_bool("inputs a b1 b2 b3\noutputs z1 z2 z3\nz1 = a | b1\nz2 = a | b2\n"
+                      "z3 = a | b3\n")
+    mech = compile_netlist(spec, nl, library=LIB).mechanism
+    preload = 1.3 * (0.5 + 0.02)
+    share = preload * 1.3 + 0.5 + 0.02 + 0.02
+    loads = part_loads(mech)
+    assert loads["net a"] == pytest.approx(3 * share, rel=1e-3)
+    assert loads["net b1"] == pytest.approx(share, rel=1e-3)
+    for k in (1, 2, 3):
+        assert loads[f"c{k}"] == pytest.approx(share, rel=1e-3)
+        assert loads[f"c{k}"] < loads["net a"] / 2

@@ -316,6 +316,8 @@ def levels_line(lv: dict) -> str:
     if lv["chosen"] == "multi" and multi.get("two_level_outputs"):
         line += ("; built two-level for a static hazard: "
                  + ", ".join(multi["two_level_outputs"]))
+    if lv["chosen"] == "multi" and multi.get("cured_outputs"):
+        line += "; static hazards cured by cubes: " + ", ".join(multi["cured_outputs"])
     if multi.get("failed"):
         line += f"; multi-level failed: {multi['failed']}"
     return line

@@ -6,8 +6,12 @@ Two reasons, both from ``001_…`` §2.6 and Appendix B:
   than its rating, a MEMORY loop whose force demand grows every time round) gets its loads
   split into groups of at most ``Amplifier.fanout_max`` loads, each group behind its own
   AMPLIFIER; the amplifier's input costs only its slider's friction, its output comes from the
-  motor. Every load of the net moves behind an amplifier, so all its paths keep the same delay
-  (a delay on one path only is the SET/RESET overlap of Appendix B.2).
+  motor. In a sequential netlist every load of the net moves behind an amplifier, so all its
+  paths keep the same delay (a delay on one path only is the SET/RESET overlap of Appendix
+  B.2). A combinational netlist gets its force amplifiers planned in one sweep of the force
+  budget from the outputs back (``plan_force_amplifiers``): a net is amplified only where its
+  driver (a cell under its strength checks, an actuator under its rating) cannot move it, and
+  then only its heaviest loads, grouped within the amplifier's own capacity.
 - **snap** — an output that must hold while an input travels but whose generator moves partway
   because a MEMORY switches before that input has finished its stroke (the output is X in the
   ternary analysis with the memories free to switch). The AMPLIFIER's bistable toggle switches
@@ -19,14 +23,17 @@ Both are plain functions ``Netlist -> Netlist``; the pipeline decides where.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
 import networkx as nx
 
 from mechc.cells.library import Library
 from mechc.errors import DesignError
+from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
-from mechc.passes.strength import strength_checks
+from mechc.passes.assemble import MechOptions, synth_context
+from mechc.passes.strength import cell_holds, force_ceiling, strength_checks
 
 #: Used when the library's AMPLIFIER does not state how many loads it may drive.
 DEFAULT_FANOUT = 2
@@ -81,11 +88,12 @@ def snap_outputs(nl: Netlist, lib: Library, outputs: Iterable[str]) -> Netlist:
     return _rebuild(nl, lib, cells, outs)
 
 
-def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
-                 reason: str = "force") -> Netlist:
+def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str], reason: str = "force",
+                 groups: dict[str, list[list[tuple[str, int]]]] | None = None) -> Netlist:
     """Every load of each named net moves behind AMPLIFIERs, at most the measured fan-out per
-    amplifier; primary outputs on the net stay on it (their load is small). ``reason`` is
-    recorded in each new cell's params (force, or a feedback delay)."""
+    amplifier (or in the ``groups`` given for it: lists of (cell, input index)); primary
+    outputs on the net stay on it (their load is small). ``reason`` is recorded in each new
+    cell's params (force, or a feedback delay)."""
     amp = amplifier_cell(lib)
     limit = fanout_limit(lib)
     names = _names(nl)
@@ -99,20 +107,170 @@ def amplify_nets(nl: Netlist, lib: Library, nets: Iterable[str],
     reach = _memories_reached(nl)
     extra: list[CellInst] = []
     for net in nets:
-        # loads that feed the same MEMORY share an amplifier where they can: two amplifiers
-        # never switch at quite the same moment, and a skew between a memory's SET and RESET
-        # paths is the overlap of Appendix B.2
-        ls = sorted(loads.get(net, []), key=lambda load: (reach.get(load[0], ()), load))
-        for g in range(0, len(ls), limit):
+        for group in (groups or {}).get(net) or _groups(loads.get(net, []), reach, limit):
             new = _fresh(f"{net}_amp", names)
             extra.append(CellInst(_fresh("a", names), amp.name, "AMPLIFIER", (net,), (new,),
                                   {"reason": reason}))
-            for cid, k in ls[g:g + limit]:
+            for cid, k in group:
                 c = cells[cid]
                 ins = list(c.inputs)
                 ins[k] = new
                 cells[cid] = CellInst(c.id, c.cell, c.type, tuple(ins), c.outputs, c.params)
     return _rebuild(nl, lib, list(cells.values()) + extra, dict(nl.outputs))
+
+
+def _groups(ls: list[tuple[str, int]], reach: dict[str, tuple[str, ...]], limit: int,
+            ask: dict[tuple[str, int], Demand] | None = None,
+            cap: float = math.inf) -> list[list[tuple[str, int]]]:
+    """A net's loads (cell, pin) in the groups that share one amplifier: at most ``limit``
+    each and, given what each asks, at most ``cap`` newtons each way; loads that feed the
+    same MEMORY together where they can (two amplifiers never switch at quite the same
+    moment, and a skew between a memory's SET and RESET paths is the overlap of Appendix
+    B.2)."""
+    ls = sorted(ls, key=lambda load: (reach.get(load[0], ()), load))
+    out: list[list[tuple[str, int]]] = []
+    total = Demand()
+    for load in ls:
+        a = ask[load] if ask is not None else Demand()
+        more = total + a
+        if not out or len(out[-1]) >= limit or max(more.right, more.left) > cap:
+            out.append([])
+            more = a
+        out[-1].append(load)
+        total = more
+    return out
+
+
+def amplifier_capacity(lib: Library, ctx: SynthContext) -> float:
+    """The largest demand (N, each way) an AMPLIFIER's output can move with every part of
+    it within its strength checks (bisection: the checks only get worse with the load)."""
+    amp = amplifier_cell(lib)
+    lo, hi = 0.0, force_ceiling(ctx)
+    for _ in range(40):
+        mid = (lo + hi) / 2
+        try:
+            ok = _asks(amp, None, ctx, Demand(mid, mid), check=True) is not None
+        except DesignError:
+            ok = False
+        lo, hi = (mid, hi) if ok else (lo, mid)
+    return lo
+
+
+def plan_force_amplifiers(nl: Netlist, lib: Library, opts: MechOptions
+                          ) -> tuple[dict[str, str], dict[str, list[list[tuple[str, int]]]]]:
+    """Nets to amplify so that every cell can drive what it must, chosen in one sweep of the
+    force budget from the outputs back (combinational netlists).
+
+    A cell's demand is what its output net's loads ask; each level multiplies it (a spring
+    preloaded 1.3x what it moves, rising 30 % over the stroke, is what the next cell back must
+    overcome), so in a deep chain it grows until some part yields. Sweeping back, each cell is
+    synthesised for its net's demand; where the cell alone fails a strength check under that
+    load (``strength.cell_holds``), or an input actuator would need more than its rating, that
+    net goes behind amplifiers (their inputs ask only slider friction), which resets the
+    demand seen further back. An amplifier is put in only where a cell cannot do without one,
+    as far back as it can be, so one amplifier relieves as many levels as the parts allow.
+    An amplifier moves at most :func:`amplifier_capacity`, so a cell that would ask more than
+    that of one input is relieved too, and a net's loads are grouped by force as well as by
+    count. Only the heaviest loads of a net go behind amplifiers, as many as its driver needs;
+    in a combinational network a delay on some paths and not others changes no settled value
+    and no ternary (hazard) result, and the kinematic proof checks the design as built.
+    Returns net -> reason and net -> its groups of loads (for :func:`amplify_nets`)."""
+    ctx = synth_context(opts)
+    limit = fanout_limit(lib)
+    cap = amplifier_capacity(lib, ctx)
+    amp = amplifier_cell(lib)
+    reach = _memories_reached(nl)
+    loads: dict[str, list[tuple[str, int]]] = {}
+    for c in nl.cells.values():
+        if c.type != "AMPLIFIER":
+            for k, net in enumerate(c.inputs):
+                loads.setdefault(net, []).append((c.id, k))
+    ask: dict[tuple[str, int], Demand] = {}  # (cell, pin) -> what it asks, friction included
+    base: dict[str, Demand] = {}  # net -> demand of what stays on it if amplified
+    for net in nl.outputs.values():
+        base[net] = Demand(opts.output_load, opts.output_load)
+    for c in nl.cells.values():
+        if c.type == "AMPLIFIER":
+            a = _asks(amp, c, ctx, Demand())
+            base[c.inputs[0]] = base.get(c.inputs[0], Demand()) + a[0]
+    out: dict[str, str] = {}
+
+    def demand_of(net: str) -> Demand:
+        d = base.get(net, Demand())
+        for load in loads.get(net, []):
+            d = d + ask[load]
+        return d
+
+    groups: dict[str, list[list[tuple[str, int]]]] = {}
+
+    def amplified(net: str, fits) -> Demand:
+        """Put the heaviest loads of ``net`` behind amplifiers, as few as leave a demand its
+        driver ``fits`` (all of them if none does); the lightest stay on the net."""
+        ls = sorted(loads.get(net, []), key=lambda load: (max(ask[load].right,
+                                                                ask[load].left), load))
+
+        def split(k: int) -> tuple[Demand, list[list[tuple[str, int]]]]:
+            d = base.get(net, Demand())
+            for load in ls[:k]:
+                d = d + ask[load]
+            gs = _groups(ls[k:], reach, limit, ask, cap)
+            for group in gs:
+                own = Demand()
+                for load in group:
+                    own = own + ask[load]
+                d = d + _asks(amp, None, ctx, own)[0]
+            return d, gs
+
+        lo, hi = 0, len(ls) - 1  # the most loads kept direct: bisection (fewer weigh less)
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            lo, hi = (mid, hi) if fits(split(mid)[0]) else (lo, mid - 1)
+        d, groups[net] = split(lo)
+        return d
+
+    state = nl.state_nets()
+    for cell in reversed(nl.topo_cells()):
+        net = cell.outputs[0]
+        cls = lib[cell.cell]
+
+        def fits(d: Demand, cell=cell, cls=cls) -> bool:
+            asks = _asks(cls, cell, ctx, d, check=True)
+            return asks is not None and max((max(a.right, a.left) for a in asks),
+                                            default=0.0) <= cap
+
+        d = demand_of(net)
+        if not fits(d) and loads.get(net) and net not in state:
+            out[net] = f"force: {cell.id} ({cell.type}) cannot drive its loads' demand"
+            d = amplified(net, fits)
+        for k, a in enumerate(_asks(cls, cell, ctx, d)):
+            ask[(cell.id, k)] = a
+
+    def actuator_fits(d: Demand) -> bool:
+        return max(d.right, d.left) + ctx.friction <= opts.actuator_force
+
+    for net in nl.inputs:
+        if not actuator_fits(demand_of(net)) and loads.get(net):
+            out[net] = "force: its actuator would be asked more than its rating"
+            amplified(net, actuator_fits)
+    return out, groups
+
+
+def _asks(cls, cell: CellInst | None, ctx, demand: Demand,
+          check: bool = False) -> list[Demand] | None:
+    """What each input of ``cell`` (an instance of ``cls``) asks of its net, guide friction
+    included, when it must deliver ``demand``; ``check``: None if the cell alone then fails
+    a strength check."""
+    n = len(cell.inputs) if cell is not None else 1
+    part = cls.synthesise(cell.id if cell else "amp", ctx, n, dict(cell.params) if cell else {},
+                          demand)
+    pins = cls.input_names(n)
+    asks = [Demand(part.data["input_loads"][p]["right_N"] + ctx.friction,
+                   part.data["input_loads"][p]["left_N"] + ctx.friction) for p in pins]
+    if check:
+        load = max([demand.right, demand.left] + [max(a.right, a.left) for a in asks])
+        if not cell_holds(cell.id if cell else "amp", part, load, ctx):
+            return None
+    return asks
 
 
 def nets_short_of_force(nl: Netlist, mech, lib: Library) -> dict[str, str]:

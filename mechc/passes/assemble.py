@@ -49,13 +49,18 @@ class MechOptions:
     angle_margin: float = 0.0  # degrees of transmission angle beyond the limit (SynthContext)
 
 
+def synth_context(opts: MechOptions) -> SynthContext:
+    """The design rules every part of a mechanism is synthesised with."""
+    mat = material(opts.material)
+    return SynthContext(stroke=opts.stroke, density=mat.density, material=mat.name,
+                        clearance=opts.clearance, margin=opts.spring_margin,
+                        overtravel=opts.overtravel, angle_margin=opts.angle_margin)
+
+
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                          opts: MechOptions | None = None) -> Mechanism:
     opts = opts or MechOptions()
-    mat = material(opts.material)
-    ctx = SynthContext(stroke=opts.stroke, density=mat.density, material=mat.name,
-                       clearance=opts.clearance, margin=opts.spring_margin,
-                       overtravel=opts.overtravel, angle_margin=opts.angle_margin)
+    ctx = synth_context(opts)
     S, w = ctx.stroke, ctx.bar
     order = [c.id for c in nl.topo_cells()]
     cells = {c.id: c for c in nl.cells.values()}

@@ -43,7 +43,7 @@ def factored_netlist(eq: Equations, library: Library, opts: MapOptions) -> Netli
 def _factor_cover(pl: Planner, cover: Cover, inputs: list[str], invert: bool) -> Key:
     n = len(inputs)
     cubes = [frozenset(c.literal_list(n)) for c in cover.cubes]
-    key = _sum(pl, cubes, inputs)
+    key = factored_sum(pl, cubes, inputs)
     if invert:
         if key[0] == "CONST":
             return ("CONST", 1 - key[1])
@@ -51,7 +51,7 @@ def _factor_cover(pl: Planner, cover: Cover, inputs: list[str], invert: bool) ->
     return key
 
 
-def _sum(pl: Planner, cubes: list[frozenset[Lit]], inputs: list[str]) -> Key:
+def factored_sum(pl: Planner, cubes: list[frozenset[Lit]], inputs: list[str]) -> Key:
     """The OR of the cubes, factored."""
     if not cubes:
         return ("CONST", 0)
@@ -72,7 +72,7 @@ def _sum(pl: Planner, cubes: list[frozenset[Lit]], inputs: list[str]) -> Key:
             break
         inner = [c - {lit} for c in rest if lit in c]
         rest = [c for c in rest if lit not in c]
-        q = _sum(pl, inner, inputs)
+        q = factored_sum(pl, inner, inputs)
         var = ("in", inputs[lit[0]])
         if q == ("CONST", 1):
             if lit[1]:

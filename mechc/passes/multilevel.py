@@ -25,6 +25,7 @@ from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube
 from mechc.logic.yosys import run_yosys
 from mechc.passes.factor import factored_netlist
+from mechc.passes.hazard_cure import cure_hazards
 from mechc.passes.map import map_equations
 from mechc.passes.map_sop import MapOptions
 from mechc.passes.minimise import MinimiseOptions, minimise
@@ -69,6 +70,7 @@ class MultiLevel:
     script: str  # the ABC script whose mapping was kept
     tried: dict[str, int] = field(default_factory=dict)  # script -> parts
     two_level_outputs: list[str] = field(default_factory=list)  # rebuilt for a hazard
+    cured_outputs: list[str] = field(default_factory=list)  # hazards cured by cubes
 
 
 def liberty(library: Library, fan_in: int | None = None) -> tuple[str, dict[str, tuple]]:
@@ -145,7 +147,7 @@ def map_multilevel(blif: str, inputs: list[str], outputs: list[str], library: Li
 
 
 #: Cut sizes tried for the hazard-free composition (each node a function of at most K nets).
-LUT_SIZES = (3, 4)
+LUT_SIZES = (3, 4, 6)
 
 
 def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
@@ -188,12 +190,21 @@ def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
     tried: dict[str, int] = {}
     for c in cands:
         bad = static_hazards(c.netlist)
-        if bad and two_level is not None:
-            c.netlist = with_two_level(c.netlist, two_level, sorted(bad))
+        if bad:
+            fixes = []  # (netlist, cured locally)
+            if two_level is not None:
+                fixes.append((with_two_level(c.netlist, two_level, sorted(bad)), False))
+            cured = cure_hazards(c.netlist, sorted(bad), library, map_opts)
+            if cured is not None and not static_hazards(cured):
+                fixes.append((cured, True))
+            if not fixes:
+                continue
+            c.netlist, local = min(fixes, key=lambda f: _parts(f[0], library))
             c.parts = _parts(c.netlist, library)
-            c.two_level_outputs = sorted(bad)
-        elif bad:
-            continue
+            if local:
+                c.cured_outputs = sorted(bad)
+            else:
+                c.two_level_outputs = sorted(bad)
         tried[c.script] = c.parts
         if best is None or c.parts < best.parts:
             best = c
@@ -214,9 +225,35 @@ def _describe(ml: MultiLevel) -> None:
     for o, net in ml.netlist.outputs.items():
         drv = ml.netlist.driver[net][0]
         how = ("hazard-free cone (the multi-level one had a static hazard)"
-               if o in ml.two_level_outputs else "multi-level network")
+               if o in ml.two_level_outputs else
+               "multi-level network, its static hazards cured by cubes"
+               if o in ml.cured_outputs else "multi-level network")
         ml.implemented[o] = (f"{how}, depth {depth.get(drv, 0)}"
                              if drv in ml.netlist.cells else net)
+
+
+def _output_bits(mod: dict, outputs: list[str], driver: dict) -> tuple[dict, dict]:
+    """Yosys' bit of each output, and bit -> the output that names its net (the first output
+    on a bit some cell drives)."""
+    out_bits = {o: mod["ports"][o]["bits"][0] for o in outputs}
+    named: dict = {}
+    for o, b in out_bits.items():
+        if b in driver and b not in named:
+            named[b] = o
+    return out_bits, named
+
+
+def _namer(taken: set[str]):
+    """A source of fresh net names n1, n2, ... that skips the names in ``taken``."""
+    counter = [0]
+
+    def fresh() -> str:
+        while True:
+            counter[0] += 1
+            net = f"n{counter[0]}"
+            if net not in taken:
+                return net
+    return fresh
 
 
 def compose_luts(doc: dict, inputs: list[str], outputs: list[str], library: Library,
@@ -232,21 +269,10 @@ def compose_luts(doc: dict, inputs: list[str], outputs: list[str], library: Libr
     for c in mod["cells"].values():
         if c["type"] != "$lut":
             raise MechcError(f"Yosys left a {c['type']} cell in its cut network")
-    out_bits = {o: mod["ports"][o]["bits"][0] for o in outputs}
-    named: dict = {}
-    for o, b in out_bits.items():
-        if b in driver and b not in named:
-            named[b] = o
+    out_bits, named = _output_bits(mod, outputs, driver)
     cells: list[CellInst] = []
-    taken = set(inputs) | set(outputs)
-    counter = {"cell": 0, "net": 0}
-
-    def fresh() -> str:
-        while True:
-            counter["net"] += 1
-            net = f"n{counter['net']}"
-            if net not in taken:
-                return net
+    counter = {"cell": 0}
+    fresh = _namer(set(inputs) | set(outputs))
 
     def node(table: str, ins: list[str], net_name) -> str:
         k = len(ins)
@@ -378,21 +404,10 @@ def netlist_from_json(doc: dict, inputs: list[str], outputs: list[str],
         if c["type"] not in cells and c["type"] != _BUFFER:
             raise MechcError(f"Yosys mapped to an unknown cell {c['type']}")
         driver[c["connections"]["Y"][0]] = cname
-    out_bits = {o: mod["ports"][o]["bits"][0] for o in outputs}
-    named: dict = {}
-    for o, b in out_bits.items():
-        if b in driver and b not in named:
-            named[b] = o
+    out_bits, named = _output_bits(mod, outputs, driver)
     nl = Netlist(inputs)
-    counter = {"cell": 0, "net": 0}
-    taken = set(inputs) | set(outputs)
-
-    def fresh() -> str:
-        while True:
-            counter["net"] += 1
-            net = f"n{counter['net']}"
-            if net not in taken:
-                return net
+    counter = {"cell": 0}
+    fresh = _namer(set(inputs) | set(outputs))
 
     def add(cid: str, type_name: str, ins: tuple[str, ...], net: str, params: dict) -> None:
         cls = library.for_type(type_name, len(ins))

@@ -6,8 +6,10 @@ force budget that passes through it (``mechc/passes/assemble.py``): a net's load
 (``data["demand"]``, the larger of towards on and towards off: the springs and loads it moves,
 with their 1.3 margin and 30 % rise, plus guide friction), for its fan-out bar and pins; each
 rod of a net carries what its own load asks (``push_rods``); an input slider carries its net's
-load; a cell's parts carry the largest load of the nets it touches (and of its own output
-demand). The actuators are position-controlled and limited
+load; a cell's parts carry the largest of its own output demand, the demand of the net it
+drives (its output slider moves that net's fan-out bar) and, for each net it loads, what its
+own input asks of that net (the one rod between them: the net's other loads pull on their
+own rods, not through this cell). The actuators are position-controlled and limited
 to their rating: they stop at the end of the stroke, before any load reaches its stop (2 % of
 the stroke beyond), so in service no part sees the actuator's full rating. A jam (a load
 blocked mid-stroke while the actuator pushes on) is NOT designed for: it would put up to the
@@ -117,12 +119,14 @@ def part_loads(mech: Mechanism) -> dict[str, float]:
     out.update({f"input {k}": net.get(k, 0.0) for k in mech.inputs})
     for cid in mech.order:
         out[cid] = max(_demand(mech.cells[cid].data.get("output_demand", {})))
-    for name, part in mech.nets.items():  # a cell carries the nets it drives and loads
-        touching = [part.data.get("driver", "")] + [
-            load.rsplit(".", 1)[0] for load in part.data.get("loads", [])]
-        for cid in touching:
-            if cid in out and not cid.startswith(("net ", "input ")):
-                out[cid] = max(out[cid], net[name])
+    for name, part in mech.nets.items():
+        drv = part.data.get("driver", "")  # the driver moves the whole net
+        if drv in mech.cells:
+            out[drv] = max(out[drv], net[name])
+        for load in part.data.get("loads", []):  # a load carries only its own rod's pull
+            cid = load.rsplit(".", 1)[0]
+            if cid in mech.cells:
+                out[cid] = max(out[cid], *_share(mech, load))
     return out
 
 
@@ -255,42 +259,69 @@ def size_parts(mech: Mechanism) -> None:
     guide_rods(mech, loads)
 
 
+def part_checks(where: str, part: Part, load: float, ctx: SynthContext) -> list[Check]:
+    """One part's checks under its design load: axial stress, lever bending, pin shear and
+    bearing (its pins as sized), spring wire stress."""
+    mat = material(ctx.material)
+    allow = plate_allowable(mat)
+    out = [Check(f"axial stress ({mat.name}, {ctx.bar:g} x {ctx.thickness:g} mm bars)",
+                 where, load / (ctx.bar * ctx.thickness), allow, "<=", "MPa")]
+    for b in part.bodies:
+        if b.kind == "lever" and b.pivot is not None and load > 0.0:
+            arm = lever_arm(part, b.id, b.pivot)
+            out.append(Check(f"lever bending ({arm:.3g} mm arm)", b.id,
+                             6 * load * arm / (ctx.thickness * ctx.bar ** 2), allow, "<=",
+                             "MPa"))
+    pins = _pins_of(part)
+    if pins and load > 0.0:
+        d = min(pins)
+        out.append(Check(f"pin shear ({d:g} mm steel pins)", where,
+                         load / (math.pi * d * d / 4), pin_shear_allowable(), "<=", "MPa"))
+        out.append(Check(f"pin bearing ({d:g} mm pins in {ctx.thickness:g} mm {mat.name})",
+                         where, load / (d * ctx.thickness), allow, "<=", "MPa"))
+    for s in part.springs:
+        if s.coil is not None:
+            out.append(Check(f"spring wire stress ({s.coil.wire:g} mm music wire)", s.id,
+                             s.coil.stress, s.coil.allowable, "<=", "MPa"))
+    return out
+
+
+def rod_check(rod: LoadedRod, E: float) -> Check:
+    """Euler buckling of one rod (over its span between guides) against its load."""
+    p_cr = euler_load(E, rod.width, rod.thickness, rod.span)
+    guided = (f", {rod.guides} guide{'s' if rod.guides > 1 else ''}: span "
+              f"{rod.span:.4g} mm") if rod.guides else ""
+    return Check(f"rod buckling (Euler, {rod.length:.4g} mm long{guided}) / load", rod.id,
+                 p_cr / rod.load, BUCKLING_SAFETY, ">=", "x")
+
+
+def cell_holds(where: str, part: Part, load: float, ctx: SynthContext) -> bool:
+    """Whether a cell's part, alone, passes its strength checks under ``load`` (its pins
+    sized for it, its own rods unguided): how the amplifier planner asks whether a cell can
+    drive a net's demand before the mechanism is assembled."""
+    d = pin_diameter(load, ctx)
+    for j in part.joints:
+        if j.kind in PIN_JOINTS:
+            j.pin_diameter = d
+    for b in part.bodies:
+        if b.kind in PIVOTED:
+            b.pin_diameter = d
+    if not all(c.passed for c in part_checks(where, part, load, ctx)):
+        return False
+    E = material(ctx.material).E
+    return all(rod_check(LoadedRod(j.id, where, float(j.length), ctx.bar, ctx.thickness,
+                                   load), E).passed
+               for j in part.joints if j.kind == "rod" and j.length and load > 0.0)
+
+
 def strength_checks(mech: Mechanism) -> list[Check]:
     """Every part: axial stress, lever bending, rod buckling, pin shear and bearing, spring wire
     stress."""
     ctx = mech.ctx
-    mat = material(ctx.material)
+    E = material(ctx.material).E
     loads = part_loads(mech)
-    allow = plate_allowable(mat)
-    area = ctx.bar * ctx.thickness
     out: list[Check] = []
     for where, part in _parts(mech):
-        load = loads.get(where, 0.0)
-        out.append(Check(f"axial stress ({mat.name}, {ctx.bar:g} x {ctx.thickness:g} mm bars)",
-                         where, load / area, allow, "<=", "MPa"))
-        for b in part.bodies:
-            if b.kind == "lever" and b.pivot is not None and load > 0.0:
-                arm = lever_arm(part, b.id, b.pivot)
-                out.append(Check(f"lever bending ({arm:.3g} mm arm)", b.id,
-                                 6 * load * arm / (ctx.thickness * ctx.bar ** 2), allow, "<=",
-                                 "MPa"))
-        pins = _pins_of(part)
-        if pins and load > 0.0:
-            d = min(pins)
-            out.append(Check(f"pin shear ({d:g} mm steel pins)", where,
-                             load / (math.pi * d * d / 4), pin_shear_allowable(), "<=", "MPa"))
-            out.append(Check(f"pin bearing ({d:g} mm pins in {ctx.thickness:g} mm {mat.name})",
-                             where, load / (d * ctx.thickness), allow, "<=", "MPa"))
-        for s in part.springs:
-            if s.coil is not None:
-                out.append(Check(f"spring wire stress ({s.coil.wire:g} mm music wire)", s.id,
-                                 s.coil.stress, s.coil.allowable, "<=", "MPa"))
-    for rod in push_rods(mech, loads):
-        if rod.load <= 0.0:
-            continue
-        p_cr = euler_load(mat.E, rod.width, rod.thickness, rod.span)
-        guided = (f", {rod.guides} guide{'s' if rod.guides > 1 else ''}: span "
-                  f"{rod.span:.4g} mm") if rod.guides else ""
-        out.append(Check(f"rod buckling (Euler, {rod.length:.4g} mm long{guided}) / load", rod.id,
-                         p_cr / rod.load, BUCKLING_SAFETY, ">=", "x"))
+        out += part_checks(where, part, loads.get(where, 0.0), ctx)
+    out += [rod_check(rod, E) for rod in push_rods(mech, loads) if rod.load > 0.0]
     return out

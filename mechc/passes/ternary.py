@@ -71,23 +71,28 @@ def _generic(type_name: str, ins: list[Tern], params: dict) -> Tern:
 def evaluate3(nl: Netlist, values: dict[str, Tern]) -> dict[str, Tern]:
     """Every net's ternary value for the input vectors in ``values``."""
     nets = dict(values)
+    size = len(next(iter(values.values()))[0]) if values else 1
     for cell in nl.topo_cells():
         out = _cell3(cell.type, [nets[n] for n in cell.inputs], cell.params)
+        if not cell.inputs:  # a constant: one value, for every vector
+            out = (np.broadcast_to(out[0], size).copy(), np.broadcast_to(out[1], size).copy())
         for net in cell.outputs:
             nets[net] = out
     return nets
 
 
-def static_hazards(nl: Netlist, seed: int = 0) -> dict[str, int]:
-    """Output -> how many single-input changes leave it logically unchanged but X in ternary
-    simulation (every vector up to MAX_EXHAUSTIVE_INPUTS inputs, a seeded sample beyond)."""
+def hazard_transitions(nl: Netlist, seed: int = 0) -> dict[str, list[tuple[int, np.ndarray]]]:
+    """Output -> [(k, vectors)]: the single-input changes that leave it logically unchanged but
+    X in ternary simulation, as input k moving from 0 to 1 at each of ``vectors`` (one column
+    per vector, one row per input; every vector up to MAX_EXHAUSTIVE_INPUTS inputs, a seeded
+    sample beyond)."""
     n = len(nl.inputs)
     if n <= MAX_EXHAUSTIVE_INPUTS:
         bits = input_matrix(n)
     else:
         rng = np.random.default_rng(seed)
         bits = rng.integers(0, 2, size=(n, SAMPLE_VECTORS)).astype(bool)
-    found: dict[str, int] = {}
+    found: dict[str, list[tuple[int, np.ndarray]]] = {}
     for k in range(n):
         base = bits[:, ~bits[k]] if n <= MAX_EXHAUSTIVE_INPUTS else bits.copy()
         base[k] = False
@@ -100,9 +105,15 @@ def static_hazards(nl: Netlist, seed: int = 0) -> dict[str, int]:
             vals[x] = (~base[i] | (i == k), base[i] | (i == k))
         t = evaluate3(nl, vals)
         for o, net in nl.outputs.items():
-            steady = a[net] == b[net]
             lo, hi = t[net]
-            bad = int(np.count_nonzero(steady & lo & hi))
-            if bad:
-                found[o] = found.get(o, 0) + bad
+            bad = (a[net] == b[net]) & lo & hi
+            if bad.any():
+                found.setdefault(o, []).append((k, base[:, bad]))
     return found
+
+
+def static_hazards(nl: Netlist, seed: int = 0) -> dict[str, int]:
+    """Output -> how many single-input changes leave it logically unchanged but X in ternary
+    simulation (every vector up to MAX_EXHAUSTIVE_INPUTS inputs, a seeded sample beyond)."""
+    return {o: sum(v.shape[1] for _, v in ts)
+            for o, ts in hazard_transitions(nl, seed).items()}
