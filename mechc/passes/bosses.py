@@ -34,8 +34,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+import shapely
 from shapely import STRtree
-from shapely.geometry import MultiPoint, Point, Polygon
+from shapely.geometry import Point, Polygon
 from shapely.ops import nearest_points, unary_union
 
 from mechc.ir.mechanism import GROUND, Body, Mechanism, SynthContext
@@ -82,10 +84,37 @@ def _plane_shapes(body: Body, tail: int = 0) -> dict[int, Polygon]:
     return {k: unary_union(v) for k, v in by_plane.items()}
 
 
+def _prime(bodies: list[Body], cache: dict) -> None:
+    """``_plane_shapes(body)`` of many bodies at once into ``cache`` (their polygons made and
+    cleaned in one vectorised call: a Python object per polygon was most of the time)."""
+    coords, index, keys = [], [], []
+    for b in bodies:
+        for i, poly in enumerate(b.outline):
+            if len(poly) >= 3:
+                coords += poly
+                index += [len(keys)] * len(poly)
+                keys.append((b.id, b.layer_of(i)))
+    if not keys:
+        return
+    rings = shapely.linearrings(np.asarray(coords, dtype=float), indices=index)
+    clean = shapely.buffer(shapely.polygons(rings), 0)
+    by_plane: dict[str, dict[int, list[Polygon]]] = {b.id: {} for b in bodies}
+    for (bid, plane), g in zip(keys, clean):
+        by_plane[bid].setdefault(plane, []).append(g)
+    for bid, shapes in by_plane.items():
+        cache[(bid, 0)] = {k: unary_union(v) for k, v in shapes.items()}
+
+
 def _disc(c: tuple[float, float], r: float) -> list[tuple[float, float]]:
     rc = r / math.cos(math.pi / SIDES)  # circumscribed: the disc of radius r lies inside
     return [(c[0] + rc * math.cos(2 * math.pi * (k + 0.5) / SIDES),
              c[1] + rc * math.sin(2 * math.pi * (k + 0.5) / SIDES)) for k in range(SIDES)]
+
+
+def _hull(pts: list[tuple[float, float]]):
+    """Convex hull of points (built from an array: shapely's MultiPoint of tuples makes a
+    Point object per vertex, a third of this pass's time on a big design)."""
+    return shapely.convex_hull(shapely.multipoints(np.asarray(pts, dtype=float)))
 
 
 def boss(shape: Polygon, centre: tuple[float, float], r: float,
@@ -93,14 +122,53 @@ def boss(shape: Polygon, centre: tuple[float, float], r: float,
     """The boss ``shape`` needs to hold a hole (or a slot to ``end``) with edge distance
     ``r``, or None where it holds it already."""
     need = [centre] if end is None else [centre, end]
-    ring = MultiPoint(need).convex_hull.buffer(r - TOL, quad_segs=8)
+    hull = _hull(need)
+    ring = hull.buffer(r - TOL, quad_segs=8)
     if shape.contains(ring):
         return None
     pts = [p for c in need for p in _disc(c, r)]
-    near = nearest_points(shape, MultiPoint(need).convex_hull)[0]
+    near = nearest_points(shape, hull)[0]
     if not shape.contains(Point(near).buffer(TOL)):  # off the body: a neck back to it
         pts += _disc((near.x, near.y), r)
-    return MultiPoint(pts).convex_hull
+    return _hull(pts)
+
+
+def _held(sites: list, bodies: dict[str, Body], ctx: SynthContext,
+          shapes_of) -> np.ndarray:
+    """Which pin sites the body's outline already holds on one of its planes, all sites in
+    one vectorised test (shapely on arrays, each body's plates prepared once): the ring
+    ``boss`` tests, contained by a plate. A body with no plate holds them all (nothing to
+    add a boss to)."""
+    n = len(sites)
+    held = np.zeros(n, dtype=bool)
+    if not n:
+        return held
+    coords, index = [], []
+    for k, (_, centre, _, end) in enumerate(sites):
+        coords.append(centre)
+        index.append(k)
+        if end is not None:
+            coords += [end]
+            index.append(k)
+    radii = np.array([boss_radius(d, ctx) - TOL for _, _, d, _ in sites])
+    rings = shapely.buffer(shapely.convex_hull(shapely.multipoints(np.asarray(coords, float),
+                                                                 indices=index)),
+                           radii, quad_segs=8)
+    pair_site, pair_shape = [], []
+    _prime([bodies[b] for b in dict.fromkeys(s[0] for s in sites)], shapes_of.cache)
+    for k, (bid, _, _, _) in enumerate(sites):
+        every = shapes_of(bodies[bid], 0)
+        if not every:
+            held[k] = True
+        for g in every.values():
+            pair_site.append(k)
+            pair_shape.append(g)
+    if pair_site:
+        shapes = np.asarray(pair_shape, dtype=object)
+        shapely.prepare(shapes)
+        inside = shapely.contains(shapes, rings[pair_site])
+        held[np.asarray(pair_site)[inside]] = True
+    return held
 
 
 def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
@@ -129,27 +197,46 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
         if "fanout_plane" in part.data:
             net_planes.add(part.data["fanout_plane"])
     net_base = min(net_planes, default=max(planes) + 1)  # nets sit above every cell plane
-    # one spatial index per plane over the polygons assembly drew; bosses added here are few
-    # and checked one by one (a scan of every polygon per pin was quadratic: minutes on a
-    # design of a thousand cells)
+    # one spatial index per plane over the polygons assembly drew, and the bounds of the
+    # bosses added here in arrays (a scan of every polygon per pin, or of every boss added
+    # per pin, was quadratic: minutes on a design of a thousand cells)
     by_plane: dict[int, list[int]] = {}
     for k, pl in enumerate(plane_of):
         by_plane.setdefault(pl, []).append(k)
     trees = {pl: STRtree([polys[k] for k in ks]) for pl, ks in by_plane.items()}
     drawn = len(polys)
-    boxes: list[tuple[float, float, float, float]] = []  # bounds of the bosses added
+    # each body's plates per plane (all, and less the arms and bars of the nets it drives),
+    # made once and again only after a boss is added to it
+    cache: dict[tuple[str, int], dict[int, Polygon]] = {}
+
+    def shapes_of(body: Body, tail: int) -> dict[int, Polygon]:
+        key = (body.id, tail)
+        if key not in cache:
+            cache[key] = _plane_shapes(body, tail)
+        return cache[key]
+
+    shapes_of.cache = cache  # type: ignore[attr-defined]
+
+    sites = [s for s in pin_sites(mech) if bodies.get(s[0]) is not None and bodies[s[0]].outline]
+    # a pin the outline holds as assembly drew it stays held as bosses are added (they only
+    # add plate): one vectorised test decides those, the rest go one by one as before
+    held = _held(sites, bodies, ctx, shapes_of)
+    boxes = np.zeros((int(np.count_nonzero(~held)), 4))  # bounds of the bosses added
+    box_plane = np.zeros(len(boxes), dtype=np.int64)
     added = []
-    for bid, centre, d, end in pin_sites(mech):
-        body = bodies.get(bid)
-        if body is None or not body.outline:
+    grown: set[str] = set()  # bodies given a boss so far: their sites are tested again
+    for (bid, centre, d, end), ok in zip(sites, held):
+        if ok:
             continue
+        body = bodies[bid]
         r = boss_radius(d, ctx)
-        every = _plane_shapes(body)
-        if not every or any(boss(g, centre, r, end) is None for g in every.values()):
+        every = shapes_of(body, 0)
+        if bid in grown and any(boss(g, centre, r, end) is None for g in every.values()):
             continue  # held already (by a net's arm or bar too: a rod's pin on its fan-out)
         # a driver's own plate takes its bosses, not the arm and bar of the nets it drives
-        shapes = _plane_shapes(body, 2 * drives.get(bid, 0)) or every
-        target = Point(centre) if end is None else MultiPoint([centre, end]).convex_hull
+        tail = 2 * drives.get(bid, 0)
+        shapes = shapes_of(body, tail) or every
+        target = Point(centre) if end is None else _hull([centre, end])
         plane = min(shapes, key=lambda k: (shapes[k].distance(target), k))
         g = boss(shapes[plane], centre, r, end)
         if g is None:
@@ -165,9 +252,12 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
             near = [by_plane[k][i] for i in trees[k].query(g, predicate="dwithin",
                                                             distance=margin)] if k in trees else []
             x0, y0, x1, y1 = g.bounds
-            near += [i for i in range(drawn, len(polys)) if plane_of[i] == k
-                     and boxes[i - drawn][0] <= x1 + margin and boxes[i - drawn][2] >= x0 - margin
-                     and boxes[i - drawn][1] <= y1 + margin and boxes[i - drawn][3] >= y0 - margin]
+            m = len(polys) - drawn
+            bx = boxes[:m]
+            hit = np.flatnonzero((box_plane[:m] == k) & (bx[:, 0] <= x1 + margin)
+                                 & (bx[:, 2] >= x0 - margin) & (bx[:, 1] <= y1 + margin)
+                                 & (bx[:, 3] >= y0 - margin))
+            near += (hit + drawn).tolist()
             return all(g.distance(polys[i]) >= margin for i in near
                        if owner[i] != bid
                        and exempt.get(frozenset((bid, owner[i]))) != "bearing")
@@ -184,14 +274,18 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
         layers = body.poly_layers or [body.layer] * len(body.outline)
         # before the arm and bar of each net it drives, which assembly appended last: a
         # driver's own polygons stay first, its nets' last
-        at = len(body.outline) - 2 * drives.get(bid, 0)
+        at = len(body.outline) - tail
         body.outline.insert(at, [(round(x, 6), round(y, 6)) for x, y in g.exterior.coords[:-1]])
         layers = [*layers[:at], plane, *layers[at:]]
         body.poly_layers = None if set(layers) == {body.layer} else layers
         body.mass += extra * ctx.thickness * ctx.density
+        grown.add(bid)
+        cache.pop((bid, 0), None)
+        cache.pop((bid, tail), None)
+        boxes[len(polys) - drawn] = g.bounds
+        box_plane[len(polys) - drawn] = plane
         owner.append(bid)
         plane_of.append(plane)
         polys.append(g)
-        boxes.append(g.bounds)
         added.append((bid, plane))
     return added
