@@ -180,12 +180,18 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
     owner: list[str] = []
     plane_of: list[int] = []
     polys: list[Polygon] = []
+    coords: list = []
+    index: list[int] = []
     for b in bodies.values():
         for i, poly in enumerate(b.outline):
             if len(poly) >= 3:
                 owner.append(b.id)
                 plane_of.append(b.layer_of(i))
-                polys.append(Polygon(poly).buffer(0))
+                coords += poly
+                index += [len(owner) - 1] * len(poly)
+    if owner:  # Polygon(poly).buffer(0) of each, in one vectorised call
+        rings = shapely.linearrings(np.asarray(coords, dtype=float), indices=index)
+        polys = list(shapely.buffer(shapely.polygons(rings), 0))
     planes = sorted(set(plane_of)) or [0]
     drives: dict[str, int] = {}
     net_planes = set()
