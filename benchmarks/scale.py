@@ -9,7 +9,7 @@ BCD-to-7-segment decoder, magnitude comparators of 8-32 bits, array multipliers 
 and, with ``--mcnc DIR`` (default: an ``mcnc`` directory beside the repository, skipped when
 absent; the MCNC PLAs are not shipped with mechc), every PLA there of at most
 ``--max-two-level-inputs`` inputs. Each circuit is compiled by ``mechc compile`` in a process of
-its own, stopped after ``--time-limit`` CPU seconds (or five times that in wall time):
+its own, stopped after ``--time-limit`` CPU seconds (or ``--wall-factor`` times that in wall):
 two-level from its ``.bool`` (or the PLA), and multi-level from its structural Verilog with
 ``--levels multi`` where ``mechc compile --help`` offers ``--levels`` (else that column stays
 empty and the run says why). A two-level compile is not attempted above
@@ -77,8 +77,9 @@ class Row:
     runs: dict[str, Run] = field(default_factory=dict)
 
 
-#: The wall-clock allowance of a compile, as a multiple of its CPU limit (a loaded machine).
-WALL_FACTOR = 5
+#: The wall-clock allowance of a compile, as a multiple of its CPU limit (a loaded machine;
+#: ``--wall-factor`` sets it).
+WALL_FACTOR = [5.0]
 
 
 def mechc(*args: str, cpu_limit: float | None = None) -> subprocess.CompletedProcess:
@@ -94,7 +95,7 @@ def mechc(*args: str, cpu_limit: float | None = None) -> subprocess.CompletedPro
             resource.setrlimit(resource.RLIMIT_CPU, (secs, secs + 5))
 
     p = subprocess.run([sys.executable, "-m", "mechc", *args], capture_output=True, text=True,
-                       timeout=cpu_limit * WALL_FACTOR if cpu_limit else None, env=env,
+                       timeout=cpu_limit * WALL_FACTOR[0] if cpu_limit else None, env=env,
                        preexec_fn=limit)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     p.cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
@@ -168,7 +169,7 @@ def compile_once(src: Path, out: Path, extra: list[str], limit: float) -> Run:
         p = mechc("compile", str(src), "-o", str(out), "--quiet", *extra,
                   cpu_limit=limit + STARTUP[0])
     except subprocess.TimeoutExpired:
-        return Run(note=f"over {limit * WALL_FACTOR:g} s wall")
+        return Run(note=f"over {limit * WALL_FACTOR[0]:g} s wall")
     if p.returncode < 0:  # SIGXCPU (or SIGKILL past the hard limit): the CPU limit ran out
         return Run(note=f"over {limit:g} CPU s")
     m = next((SUMMARY.search(line) for line in p.stdout.splitlines() if SUMMARY.search(line)),
@@ -269,7 +270,10 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--time-limit", type=float, default=120.0, metavar="S",
                     help="CPU seconds one compile may take, start-up aside (default: "
-                    "%(default)s; and 5x that in wall time)")
+                    "%(default)s; and --wall-factor times that in wall time)")
+    ap.add_argument("--wall-factor", type=float, default=WALL_FACTOR[0], metavar="F",
+                    help="wall-clock allowance of a compile as a multiple of its CPU limit "
+                    "(default: %(default)s; more on a machine busy with other work)")
     ap.add_argument("--max-two-level-inputs", type=int, default=16, metavar="N",
                     help="two-level compiles are not attempted above N inputs (default: "
                     "%(default)s)")
@@ -282,6 +286,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="comma-separated columns to measure (default: %(default)s)")
     ap.add_argument("--chart", type=Path, default=ROOT / "docs" / "perf" / "scale.png")
     args = ap.parse_args(argv)
+    WALL_FACTOR[0] = args.wall_factor
     wanted = [m for m in METHODS if m in args.methods.split(",")]
     if not wanted or set(args.methods.split(",")) - set(METHODS):
         ap.error(f"--methods: choose from {', '.join(METHODS)}")
