@@ -176,7 +176,8 @@ def compile_once(src: Path, out: Path, extra: list[str], limit: float) -> Run:
              None)
     if m is None:
         err = (p.stderr.strip().splitlines() or ["no summary"])[-1]
-        return Run(note=f"error: {err[:80]}", status=p.returncode)
+        err = re.sub(r"^\S*?:\d+:\d+: error: ", "", err)  # the temporary file's place
+        return Run(note=f"error: {err[:80].replace('|', '/')}", status=p.returncode)
     run = Run(int(m.group(1)), int(m.group(2)), max(p.cpu - STARTUP[0], 0.0),
               status=p.returncode)
     if p.returncode != 0:  # a whole compile still: its time counts, the table says so
