@@ -1,14 +1,15 @@
 """Compile time and parts against circuit size: two-level against multi-level synthesis.
 
     python benchmarks/scale.py [--time-limit 120] [--max-two-level-inputs 16]
-                               [--mcnc DIR] [--only NAME,...] [--markdown] [--chart FILE]
+                               [--mcnc DIR] [--only NAME,...] [--methods two-level,multi-level]
+                               [--markdown] [--chart FILE]
 
 Circuits (``mechc.bench.scale_circuits``): ripple adders of 2-32 bits, a 74181-style ALU, a
 BCD-to-7-segment decoder, magnitude comparators of 8-32 bits, array multipliers 4x4-12x12;
 and, with ``--mcnc DIR`` (default: an ``mcnc`` directory beside the repository, skipped when
 absent; the MCNC PLAs are not shipped with mechc), every PLA there of at most
 ``--max-two-level-inputs`` inputs. Each circuit is compiled by ``mechc compile`` in a process of
-its own, stopped after ``--time-limit`` CPU seconds (or five times that in wall time):
+its own, stopped after ``--time-limit`` CPU seconds (or ``--wall-factor`` times that in wall):
 two-level from its ``.bool`` (or the PLA), and multi-level from its structural Verilog with
 ``--levels multi`` where ``mechc compile --help`` offers ``--levels`` (else that column stays
 empty and the run says why). A two-level compile is not attempted above
@@ -20,8 +21,9 @@ of starting mechc (measured in the same run, ``mechc compile --help``), so other
 shared machine does not inflate it: parse, minimise or synthesise, map, place, assemble,
 checks, proofs, write. The fitted exponent is the slope
 of log(time) against log(cells) by least squares, per method. ``--markdown`` prints the table
-in Markdown and rewrites it in docs/performance.md; ``--chart`` (default docs/perf/scale.png)
-draws time and parts against cells on log-log axes.
+in Markdown and rewrites it in docs/performance.md, keeping the rows and columns this run did
+not measure (``--only``, ``--methods``) as they were, and fits over the whole table;
+``--chart`` (default docs/perf/scale.png) draws time and parts against cells on log-log axes.
 """
 
 from __future__ import annotations
@@ -75,8 +77,9 @@ class Row:
     runs: dict[str, Run] = field(default_factory=dict)
 
 
-#: The wall-clock allowance of a compile, as a multiple of its CPU limit (a loaded machine).
-WALL_FACTOR = 5
+#: The wall-clock allowance of a compile, as a multiple of its CPU limit (a loaded machine;
+#: ``--wall-factor`` sets it).
+WALL_FACTOR = [5.0]
 
 
 def mechc(*args: str, cpu_limit: float | None = None) -> subprocess.CompletedProcess:
@@ -92,11 +95,63 @@ def mechc(*args: str, cpu_limit: float | None = None) -> subprocess.CompletedPro
             resource.setrlimit(resource.RLIMIT_CPU, (secs, secs + 5))
 
     p = subprocess.run([sys.executable, "-m", "mechc", *args], capture_output=True, text=True,
-                       timeout=cpu_limit * WALL_FACTOR if cpu_limit else None, env=env,
+                       timeout=cpu_limit * WALL_FACTOR[0] if cpu_limit else None, env=env,
                        preexec_fn=limit)
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     p.cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return p
+
+
+#: The columns, in the table's order.
+METHODS = ("two-level", "multi-level")
+
+
+def table_rows(doc: str) -> list[Row]:
+    """The rows of the table in ``doc`` (between the markers), read back into runs."""
+    if BEGIN not in doc or END not in doc:
+        return []
+    lines = [ln for ln in doc.split(BEGIN, 1)[1].split(END, 1)[0].splitlines()
+             if ln.startswith("|")]
+    if len(lines) < 2:
+        return []
+    head = [c.strip() for c in lines[0].strip("|").split("|")]
+    out = []
+    for ln in lines[2:]:
+        cells = dict(zip(head, (c.strip() for c in ln.strip("|").split("|"))))
+        row = Row(cells["circuit"], int(cells["inputs"]), int(cells["outputs"]))
+        for m in METHODS:
+            if f"{m} cells" not in cells or cells[f"{m} cells"] in ("", "—"):
+                continue
+            row.runs[m] = parse_run(cells[f"{m} cells"], cells[f"{m} parts"], cells[f"{m} s"])
+        out.append(row)
+    return out
+
+
+def parse_run(cells: str, parts: str, seconds: str) -> Run:
+    """A table entry back into a ``Run`` (the inverse of ``Run.cell_text``)."""
+    if not cells.isdigit():
+        return Run(note=cells)
+    m = re.fullmatch(r"([\d.]+)(?: \((.*)\))?", seconds)
+    if m is None:
+        raise ValueError(f"unreadable seconds entry {seconds!r}")
+    return Run(int(cells), int(parts) if parts.isdigit() else None, float(m.group(1)),
+               note=m.group(2) or "")
+
+
+def merge(old: list[Row], new: list[Row]) -> tuple[list[Row], int]:
+    """The old table's rows with this run's measurements over them (rows in the old order,
+    new circuits after), and how many entries (circuit and column) kept the old value."""
+    fresh = {r.name: r for r in new}
+    out, kept = [], 0
+    for r in old:
+        if r.name in fresh:
+            n = fresh.pop(r.name)
+            kept += sum(1 for m in r.runs if m not in n.runs)
+            r = Row(n.name, n.inputs, n.outputs, {**r.runs, **n.runs})
+        else:
+            kept += len(r.runs)
+        out.append(r)
+    return out + list(fresh.values()), kept
 
 
 #: CPU seconds of starting mechc (set by main: the least of three runs).
@@ -114,14 +169,15 @@ def compile_once(src: Path, out: Path, extra: list[str], limit: float) -> Run:
         p = mechc("compile", str(src), "-o", str(out), "--quiet", *extra,
                   cpu_limit=limit + STARTUP[0])
     except subprocess.TimeoutExpired:
-        return Run(note=f"over {limit * WALL_FACTOR:g} s wall")
+        return Run(note=f"over {limit * WALL_FACTOR[0]:g} s wall")
     if p.returncode < 0:  # SIGXCPU (or SIGKILL past the hard limit): the CPU limit ran out
         return Run(note=f"over {limit:g} CPU s")
     m = next((SUMMARY.search(line) for line in p.stdout.splitlines() if SUMMARY.search(line)),
              None)
     if m is None:
         err = (p.stderr.strip().splitlines() or ["no summary"])[-1]
-        return Run(note=f"error: {err[:80]}", status=p.returncode)
+        err = re.sub(r"^\S*?:\d+:\d+: error: ", "", err)  # the temporary file's place
+        return Run(note=f"error: {err[:80].replace('|', '/')}", status=p.returncode)
     run = Run(int(m.group(1)), int(m.group(2)), max(p.cpu - STARTUP[0], 0.0),
               status=p.returncode)
     if p.returncode != 0:  # a whole compile still: its time counts, the table says so
@@ -215,7 +271,10 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--time-limit", type=float, default=120.0, metavar="S",
                     help="CPU seconds one compile may take, start-up aside (default: "
-                    "%(default)s; and 5x that in wall time)")
+                    "%(default)s; and --wall-factor times that in wall time)")
+    ap.add_argument("--wall-factor", type=float, default=WALL_FACTOR[0], metavar="F",
+                    help="wall-clock allowance of a compile as a multiple of its CPU limit "
+                    "(default: %(default)s; more on a machine busy with other work)")
     ap.add_argument("--max-two-level-inputs", type=int, default=16, metavar="N",
                     help="two-level compiles are not attempted above N inputs (default: "
                     "%(default)s)")
@@ -224,12 +283,18 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", help="comma-separated circuit names")
     ap.add_argument("--markdown", action="store_true",
                     help="print the table in Markdown and rewrite it in docs/performance.md")
+    ap.add_argument("--methods", default=",".join(METHODS),
+                    help="comma-separated columns to measure (default: %(default)s)")
     ap.add_argument("--chart", type=Path, default=ROOT / "docs" / "perf" / "scale.png")
     args = ap.parse_args(argv)
+    WALL_FACTOR[0] = args.wall_factor
+    wanted = [m for m in METHODS if m in args.methods.split(",")]
+    if not wanted or set(args.methods.split(",")) - set(METHODS):
+        ap.error(f"--methods: choose from {', '.join(METHODS)}")
     levels = has_levels()
     STARTUP[0] = min(mechc("compile", "--help").cpu for _ in range(3))
     print(f"start-up: {STARTUP[0]:.2f} CPU s (subtracted from every compile)")
-    methods = ["two-level"] + (["multi-level"] if levels else [])
+    methods = [m for m in wanted if m == "two-level" or levels]
     if not levels:
         print("note: this mechc's compile has no --levels option: multi-level synthesis is not "
               "there yet, so only two-level is measured (the multi-level column stays empty)")
@@ -259,14 +324,16 @@ def main(argv: list[str] | None = None) -> int:
                 multi_src = work / f"{name}.v"
                 multi_src.write_text(c.verilog_text())
             row = Row(name, n, m)
-            if two_src is None or n > args.max_two_level_inputs:
+            if "two-level" not in methods:
+                pass
+            elif two_src is None or n > args.max_two_level_inputs:
                 row.runs["two-level"] = Run(note=f"not attempted (> {args.max_two_level_inputs}"
                                             " inputs)")
             else:
                 row.runs["two-level"] = compile_once(two_src, work / f"{name}.2.json",
                                                      ["--levels", "2"] if levels else [],
                                                      args.time_limit)
-            if levels:
+            if "multi-level" in methods:
                 row.runs["multi-level"] = compile_once(multi_src, work / f"{name}.m.json",
                                                        ["--levels", "multi"], args.time_limit)
             rows.append(row)
@@ -274,6 +341,10 @@ def main(argv: list[str] | None = None) -> int:
                 f"{k} {r.cells or '-'} cells {r.parts or '-'} parts "
                 f"{'' if r.seconds is None else f'{r.seconds:.2f} s'} {r.note}".rstrip()
                 for k, r in row.runs.items()), flush=True)
+    kept = 0
+    if args.markdown:  # the table's other rows and columns stay as the run before left them
+        rows, kept = merge(table_rows(DOC.read_text()), rows)
+        methods = [m for m in METHODS if any(m in r.runs for r in rows)]
     fits = {m: fit(rows, m) for m in methods}
     for m, f in fits.items():
         if f is None:
@@ -294,6 +365,9 @@ def main(argv: list[str] | None = None) -> int:
         exps = "; ".join(f"{m}: time ~ cells^{f[0]:.2f} ({f[1]} circuits)"
                          for m, f in fits.items() if f)
         text = table + (f"\n\nFitted exponent: {exps}." if exps else "")
+        if kept:
+            text += (f" {kept} of the table's entries were not measured in this run: they "
+                     "are the run before's.")
         print(text)
         doc = DOC.read_text()
         if BEGIN in doc and END in doc:

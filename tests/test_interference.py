@@ -354,3 +354,26 @@ def test_pairs_sharing_a_plane_counts_without_listing_pairs():
                   for _ in range(int(rng.integers(0, 40)))]
         brute = sum(1 for a, b in itertools.combinations(layers, 2) if a & b)
         assert pairs_sharing_a_plane(layers) == brute
+
+
+@pytest.mark.parametrize("columns", [1, 2, 3])
+def test_distinct_poses_are_numpys_unique_rows(columns):
+    """A body's distinct poses found by comparing states (few poses) or by sorting (many) are
+    exactly ``np.unique``'s: same order, same first state, same state-to-pose map; zeros of
+    either sign, unsolved states (inf) and more poses than ``FEW_POSES`` included."""
+    from mechc.physics.interference import FEW_POSES, _distinct_rows
+
+    rng = np.random.default_rng(columns)
+    for trial in range(60):
+        poses = int(rng.integers(1, 2 * FEW_POSES + 2))
+        table = rng.choice([-1.5, -0.0, 0.0, 0.25, 2.0, np.inf], size=(poses, columns))
+        free = rng.random(table.shape) < 0.5
+        table[free] = np.round(rng.normal(size=int(free.sum())), 2)
+        key = table[rng.integers(0, poses, size=int(rng.integers(1, 300)))]
+        first, inverse = _distinct_rows(key)
+        if columns == 1:
+            _, f2, i2 = np.unique(key[:, 0], return_index=True, return_inverse=True)
+        else:
+            _, f2, i2 = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        assert np.array_equal(first, f2), trial
+        assert np.array_equal(inverse, i2.reshape(-1)), trial

@@ -79,3 +79,39 @@ def test_verilog_is_read_by_yosys():
     assert run.returncode == 0, run.log
     for c in suite():  # every module read, with its ports
         assert f"=== {c.name} ===" in run.log
+
+
+def test_the_benchmark_table_reads_back_and_merges():
+    """benchmarks/scale.py rewrites its table in the docs keeping what a run did not measure:
+    the table it prints reads back to the same runs, and a run of one column of one circuit
+    replaces only that entry."""
+    import importlib.util
+    import sys
+
+    from tests.helpers import ROOT
+
+    spec = importlib.util.spec_from_file_location("scale_bench", ROOT / "benchmarks" / "scale.py")
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = mod  # its dataclasses look their module up
+    spec.loader.exec_module(mod)
+    Run, Row = mod.Run, mod.Row
+    old = [Row("a", 4, 3, {"two-level": Run(8, 62, 0.21)}),
+           Row("b", 8, 5, {"two-level": Run(84, 670, 3.25, "design checks failed"),
+                           "multi-level": Run(note="over 60 CPU s")}),
+           Row("c", 32, 17, {"two-level": Run(note="not attempted (> 16 inputs)")})]
+    text = mod.markdown(old, list(mod.METHODS))
+    doc = f"x\n{mod.BEGIN}\n{text}\n{mod.END}\ny"
+    back = mod.table_rows(doc)
+    assert [(r.name, r.inputs, r.outputs) for r in back] == [("a", 4, 3), ("b", 8, 5),
+                                                             ("c", 32, 17)]
+    for r0, r1 in zip(old, back):
+        assert set(r0.runs) == set(r1.runs)
+        for m in r0.runs:
+            a, b = r0.runs[m], r1.runs[m]
+            assert (a.cells, a.parts, a.seconds, a.note) == (b.cells, b.parts, b.seconds, b.note)
+    new = [Row("b", 8, 5, {"multi-level": Run(40, 300, 1.5)}), Row("d", 1, 1, {})]
+    merged, kept = mod.merge(back, new)
+    assert [r.name for r in merged] == ["a", "b", "c", "d"]
+    assert merged[1].runs["multi-level"].cells == 40
+    assert merged[1].runs["two-level"].cells == 84  # not measured again: kept
+    assert kept == 3  # a's two-level, b's two-level, c's two-level

@@ -20,6 +20,7 @@ and the spring stress check (``mechc/passes/strength.py``) fails with the number
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 from mechc.cells.materials import MUSIC_WIRE, SpringWire
 from mechc.ir.mechanism import Coil
@@ -51,6 +52,7 @@ def coil(d: float, c: float, rate: float, force: float, kind: str = "extension",
     return Coil(d, D, n, free, force, tau, wire.torsional_yield(d) / SPRING_SAFETY, kind)
 
 
+@lru_cache(maxsize=1 << 16)  # a design's amplifiers ask the same springs: asked once each
 def design_coil(rate: float, force: float, kind: str = "extension",
                 wire: SpringWire = MUSIC_WIRE) -> Coil:
     """The thinnest stocked wire (and then the shortest spring) whose stress at ``force`` keeps

@@ -48,7 +48,12 @@ class Netlist:
         self.cells: dict[str, CellInst] = {}
         self.driver: dict[str, tuple[str, str]] = {}  # net -> (node, pin)
         self.graph = nx.MultiDiGraph()
-        self._edges_pending: list[tuple[str, str, str]] = []
+        # edges whose net has no driver yet, by net, each with its place in the order edges
+        # were asked for (a scan of every pending edge per cell added was quadratic: a design
+        # built in any order but a topological one held thousands pending)
+        self._pending: dict[str, list[tuple[int, str, str, str]]] = {}
+        self._asked = 0
+        self._topo: list[str] | None = None  # topo_cells' order, until the netlist changes
         for name in self.inputs:
             self.graph.add_node(in_node(name), kind="input")
             self.driver[name] = (in_node(name), name)
@@ -61,38 +66,46 @@ class Netlist:
         if cell.id in self.cells:
             raise ValueError(f"duplicate cell id {cell.id}")
         self.cells[cell.id] = cell
+        self._topo = None
         self.graph.add_node(cell.id, kind="cell", cell=cell)
         outs = out_pins or [f"Z{k}" if k else "Z" for k in range(len(cell.outputs))]
         for net, pin in zip(cell.outputs, outs):
             if net in self.driver:
                 raise ValueError(f"net {net} has two drivers")
             self.driver[net] = (cell.id, pin)
+        # the edges waiting for the nets this cell drives, in the order they were asked for,
+        # then the cell's own inputs in pin order (the graph's edge order, which later passes
+        # iterate, is the one a scan of every pending edge would give)
+        waiting = sorted(e for net in cell.outputs for e in self._pending.pop(net, ()))
+        for _, node, pin, net in waiting:
+            self._edge(net, node, pin)
         pins = pin_names or [chr(ord("A") + k) for k in range(len(cell.inputs))]
         for net, pin in zip(cell.inputs, pins):
-            self._edges_pending.append((net, cell.id, pin))
-        self._flush()
+            self._ask(net, cell.id, pin)
         return cell
 
-    def _flush(self) -> None:
-        still = []
-        for net, node, pin in self._edges_pending:
-            if net in self.driver:
-                self.graph.add_edge(self.driver[net][0], node, key=(net, pin), net=net, pin=pin)
-            else:
-                still.append((net, node, pin))
-        self._edges_pending = still
+    def _ask(self, net: str, node: str, pin: str) -> None:
+        """An edge from ``net``'s driver to ``node``'s ``pin``, now or once the net has one."""
+        if net in self.driver:
+            self._edge(net, node, pin)
+        else:
+            self._pending.setdefault(net, []).append((self._asked, node, pin, net))
+        self._asked += 1
+
+    def _edge(self, net: str, node: str, pin: str) -> None:
+        self.graph.add_edge(self.driver[net][0], node, key=(net, pin), net=net, pin=pin)
 
     def set_output(self, name: str, net: str) -> None:
         self.outputs[name] = net
+        self._topo = None
         self.graph.add_node(out_node(name), kind="output")
-        self._edges_pending.append((net, out_node(name), name))
-        self._flush()
+        self._ask(net, out_node(name), name)
 
     def check(self) -> None:
         """Every net used has a driver; every cycle passes through a MEMORY's Q (feedback of a
         sequential circuit); any other cycle is a combinational loop and an error."""
-        if self._edges_pending:
-            net, node, _pin = self._edges_pending[0]
+        if self._pending:
+            _, node, _pin, net = min(e for es in self._pending.values() for e in es)
             raise ValueError(f"net '{net}' used by {node} has no driver")
         comb = self.combinational_graph()
         if not nx.is_directed_acyclic_graph(comb):
@@ -127,9 +140,13 @@ class Netlist:
         return out
 
     def topo_cells(self) -> list[CellInst]:
-        """Cells in a combinational order (MEMORY outputs count as sources)."""
-        order = nx.lexicographical_topological_sort(self.combinational_graph(), key=_sort_key)
-        return [self.cells[n] for n in order if n in self.cells]
+        """Cells in a combinational order (MEMORY outputs count as sources); the order is
+        kept until a cell or output is added (evaluation asks for it on every call)."""
+        if self._topo is None:
+            order = nx.lexicographical_topological_sort(self.combinational_graph(),
+                                                        key=_sort_key)
+            self._topo = [n for n in order if n in self.cells]
+        return [self.cells[n] for n in self._topo]
 
     def depth(self) -> dict[str, int]:
         """Logic depth of every cell: 1 + the deepest cell among its drivers (inputs and MEMORY

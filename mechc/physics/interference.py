@@ -420,10 +420,7 @@ class _BodyPoses:
                            axis=1)
         bad = np.isnan(key).any(axis=1)
         key = np.where(np.isnan(key), np.inf, np.round(key, _KEY_DECIMALS))
-        if key.shape[1] == 1:  # one coordinate (sliders, levers): the faster 1-D unique
-            _, first, inverse = np.unique(key[:, 0], return_index=True, return_inverse=True)
-        else:
-            _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+        first, inverse = _distinct_rows(key)
         inverse = inverse.reshape(-1)
         valid = ~bad[first]
         polys = [np.asarray(p, dtype=float) for p in body.outline if len(p) >= 3]
@@ -452,6 +449,46 @@ class _BodyPoses:
             g = shapely.polygons(coords)
             self._geoms[k] = g
         return g
+
+
+#: up to this many distinct poses a body's are told apart by comparing every state with each
+#: (a body of a big design takes two or three); more go to ``np.unique``'s sort
+FEW_POSES = 16
+
+
+def _distinct_rows(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct rows of ``key`` (states x coordinates, no NaN) as ``np.unique(key,
+    axis=0, return_index=True, return_inverse=True)`` gives them (rows in ascending
+    lexicographic order, the first state of each, each state's row), found without sorting
+    the states when they are few: ``np.unique`` sorts rows of several columns as records,
+    which took most of the interference check's time on a design of thousands of bodies."""
+    n = len(key)
+    firsts: list[int] = []
+    masks: list[np.ndarray] = []
+    left = np.ones(n, dtype=bool)
+    i = 0
+    while True:
+        same = (key == key[i]).all(axis=1)
+        firsts.append(i)
+        masks.append(same)
+        left &= ~same
+        if not left.any():
+            break
+        if len(firsts) >= FEW_POSES:
+            if key.shape[1] == 1:
+                _, first, inverse = np.unique(key[:, 0], return_index=True,
+                                              return_inverse=True)
+            else:
+                _, first, inverse = np.unique(key, axis=0, return_index=True,
+                                              return_inverse=True)
+            return first, inverse.reshape(-1)
+        i = int(np.argmax(left))
+    rows = key[firsts]
+    order = np.lexsort(rows.T[::-1])  # first column first
+    inverse = np.empty(n, dtype=np.intp)
+    for rank, j in enumerate(order.tolist()):
+        inverse[masks[j]] = rank
+    return np.asarray(firsts, dtype=np.intp)[order], inverse
 
 
 def _sub_poses(bid: str, poses: Poses, idx: np.ndarray, n: int) -> Poses:
