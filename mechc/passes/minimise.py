@@ -16,16 +16,19 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
+from scipy import sparse
 
 from mechc.errors import MechcError, UsageError
 from mechc.ir.equations import Cover, Equations, XorForm
 from mechc.ir.spec import Spec
-from mechc.logic.cover import min_cover, share_covers
+from mechc.logic.cover import min_cover, reduce_problem, share_covers, unique_rows
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
 from mechc.logic.espresso import check_cover, espresso
 from mechc.logic.hazards import hazard_free
+from mechc.logic.implicants import cube_points, own_primes, region_sets, table_fits, ternary_table
 from mechc.logic.multi import minimise_multi
 from mechc.logic.primes import TooManyPrimes, prime_implicants
+from mechc.logic.setcover import heuristic_cover
 
 
 @dataclass
@@ -55,13 +58,18 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     m = len(spec.outputs)
     # the mapper's alternatives share one budget, so many outputs do not multiply it
     aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
-    for name in spec.outputs:
-        table = spec.table(name)
-        covers[name], prime_sets[name] = _minimise_table(table, n, opts)
+    tables = np.array([spec.table(o) for o in spec.outputs])
+    own = _own_primes(tables != 0, n)  # every output's primes at once (None: too wide)
+    comp_own = _own_primes(tables != 1, n) if opts.complements else None
+    for i, name in enumerate(spec.outputs):
+        table = tables[i]
+        covers[name], prime_sets[name] = _minimise_table(
+            table, n, opts, primes=own[i] if own is not None else None)
         if not covers[name].proven and covers[name].method != "expand":
             limited.append(f"cover of {name}")
         if opts.complements:
-            comps[name], comp_sets[name] = _minimise_alt(_complement(table), n, aopts)
+            comps[name], comp_sets[name] = _minimise_alt(
+                _complement(table), n, aopts, comp_own[i] if comp_own is not None else None)
             if comps[name].method == "greedy" or comps[name].method.endswith("(time limit)"):
                 limited.append(f"complement cover of {name} (a mapper alternative)")
     eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
@@ -144,26 +152,47 @@ def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
     return len(distinct), sum(c.literals() for c in distinct) + sum(len(x) for x in covers)
 
 
-def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions, deadline: bool = False):
+#: Every output's primes come from one ternary table (``implicants.own_primes``) up to this
+#: many cubes (3**15: 14 million entries, a fraction of a second); beyond, per output by the
+#: Shannon recursion of ``primes.py``.
+OWN_TABLE_MAX_CUBES = 3 ** 15
+
+
+def _own_primes(regions: np.ndarray, n: int) -> list | None:
+    """Each row's primes from one ternary table, or None when the table would be too big."""
+    m = regions.shape[0]
+    if 3 ** n > OWN_TABLE_MAX_CUBES or not table_fits(n, m):
+        return None
+    return own_primes(ternary_table(region_sets(regions), n, m), n, m)
+
+
+def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions, deadline: bool = False,
+                    primes: tuple[np.ndarray, np.ndarray] | None = None):
     """Exact cover of one output (primes, then the covering program). With ``deadline`` the
     time limit also bounds the prime generation (a start for the multi-output step), past
-    which primes are grown from the on-minterms instead (method ``expand``)."""
+    which primes are grown from the on-minterms instead (method ``expand``). ``primes``: the
+    output's primes already known (from ``_own_primes``)."""
     t0 = time.perf_counter()
     on = np.flatnonzero(table == 1).astype(np.int64)
     dc = np.flatnonzero(table == DC).astype(np.int64)
     if len(on) == 0:
         return Cover([], True, "exact", time.perf_counter() - t0), None
     region = table != 0
-    try:
-        masks, values = prime_implicants(region, limit=opts.prime_limit,
-                                         deadline=t0 + opts.time_limit if deadline else None)
-        method_note = None
-    except TooManyPrimes:
-        masks, values = expand_primes(region, on, n)
-        method_note = "expand"
+    method_note = None
+    if primes is not None and len(primes[0]) <= opts.prime_limit:
+        masks, values = primes
+    else:
+        try:
+            if primes is not None:
+                raise TooManyPrimes(len(primes[0]))
+            masks, values = prime_implicants(region, limit=opts.prime_limit,
+                                             deadline=t0 + opts.time_limit if deadline
+                                             else None)
+        except TooManyPrimes:
+            masks, values = expand_primes(region, on, n)
+            method_note = "expand"
     # candidates that cover at least one on-minterm
-    useful = np.array([bool(((on & m) == v).any()) for m, v in zip(masks, values)], dtype=bool)
-    masks, values = masks[useful], values[useful]
+    masks, values = _useful(masks, values, on)
     res = min_cover(masks, values, on, dc, n, opts.time_limit)
     cubes = [Cube(int(masks[i]), int(values[i])) for i in res.chosen]
     proven = res.proven and method_note is None
@@ -198,15 +227,39 @@ ALT_BUDGET = 24.0
 HAZARD_BUDGET = 2.0
 
 
-def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
+def _useful(masks: np.ndarray, values: np.ndarray, on: np.ndarray):
+    """The candidate cubes that cover at least one on-minterm."""
+    if len(masks) == 0:
+        return masks, values
+    keep = np.zeros(len(masks), dtype=bool)
+    step = max(1, 4_000_000 // len(masks))
+    for a in range(0, len(on), step):
+        keep |= ((on[a:a + step, None] & masks[None, :]) == values[None, :]).any(axis=0)
+    return masks[keep], values[keep]
+
+
+#: Local search steps for a mapper alternative's cover over all its primes (a result that
+#: does not depend on how busy the machine is).
+ALT_LOCAL_STEPS = 100
+
+
+def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions,
+                  primes: tuple[np.ndarray, np.ndarray] | None = None):
     """A cover for one of the mapper's alternatives (complement, XOR residual): exact when
-    small, otherwise a heuristic prime cover (these are never reported as the minimum)."""
+    small, otherwise a heuristic prime cover (these are never reported as the minimum): local
+    search over all primes where the ternary table gives them (``primes``, or one built here),
+    else espresso's loop."""
     if n <= ALT_EXACT_MAX_INPUTS:
-        return _minimise_table(table, n, _alt(opts))
+        return _minimise_table(table, n, _alt(opts), primes=primes)
     t0 = time.perf_counter()
     onm = np.flatnonzero(table == 1).astype(np.int64)
     if not len(onm):
         return Cover([], True, "exact", 0.0), None
+    if primes is None:
+        got = _own_primes((table != 0)[None, :], n)
+        primes = got[0] if got is not None else None
+    if primes is not None and len(primes[0]) <= opts.prime_limit:
+        return _local_cover(table, n, primes, onm, opts, t0)
     # espresso starts from cubes, not minterms: greedy primes of the on-set (inside on ∪ dc)
     # and of the dc-set (inside dc). From 24576 minterms (the complement of a two-literal
     # product of 15 inputs) its 3 s ran out before EXPAND had merged them, and the mapper
@@ -220,6 +273,40 @@ def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
     method = "espresso" if res.complete else "espresso (time limit)"
     return (Cover(list(res.cubes), False, method, time.perf_counter() - t0),
             (masks, values, onm, dcm))
+
+
+def _local_cover(table: np.ndarray, n: int, primes, onm: np.ndarray, opts: MinimiseOptions,
+                 t0: float):
+    """Fewest primes (then literals) covering the on-minterms: essential columns and
+    dominance, then row weighting local search (``setcover.py``) on what is left."""
+    masks, values = primes
+    dcm = np.flatnonzero(table == DC).astype(np.int64)
+    # each prime's points listed directly (a prime of few literals holds thousands of them;
+    # testing every on-minterm against every prime cost more than the search)
+    cid, pts = cube_points(masks, values, n)
+    rowid = np.full(1 << n, -1, dtype=np.int64)
+    rowid[onm] = np.arange(len(onm))
+    r = rowid[pts]
+    A = sparse.csr_matrix((np.ones(int((r >= 0).sum()), dtype=np.int8), (r[r >= 0], cid[r >= 0])),
+                          shape=(len(onm), len(masks)))
+    useful = np.diff(A.tocsc().indptr) > 0
+    masks, values = masks[useful], values[useful]
+    A = unique_rows(A[:, np.flatnonzero(useful)])
+    lits = np.array([int(x).bit_count() for x in masks], dtype=np.int64)
+    forced, rows, cols = reduce_problem(A, (n + 1) * len(masks) + lits.astype(float))
+    chosen = forced
+    if len(rows):
+        got = heuristic_cover(A[rows][:, cols], lits[cols],
+                              min(opts.time_limit, opts.alt_time_limit),
+                              max_steps=ALT_LOCAL_STEPS, min_steps=ALT_LOCAL_STEPS)
+        chosen = np.concatenate([forced, cols[got]])
+    chosen = np.sort(chosen)
+    cubes = [Cube(int(masks[i]), int(values[i])) for i in chosen]
+    # the consensus terms are then looked for among the cover's own cubes and primes grown
+    # around the pairs it misses (as after espresso): over every prime the program is too
+    # large for its time limit
+    return (Cover(cubes, False, "primes+local search", time.perf_counter() - t0),
+            (masks[chosen], values[chosen], onm, dcm))
 
 
 def _alt(opts: MinimiseOptions) -> MinimiseOptions:
