@@ -17,6 +17,7 @@ Exit status 1 if mechc has more products than espresso on any PLA.
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -28,6 +29,9 @@ from mechc.passes.minimise import MinimiseOptions, minimise
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "minimisation.md"
+#: The same measurements before the minimiser's speed-up (products, parts, seconds per PLA):
+#: the reference for "no more parts than before".
+BASELINE = Path(__file__).with_name("mcnc_baseline.json")
 BEGIN, END = "<!-- mcnc table begin -->", "<!-- mcnc table end -->"
 #: espresso's product counts on the MCNC PLAs (multi-output heuristic cover), used only when
 #: pyeda is not installed.
@@ -89,8 +93,16 @@ def mapped(eq, lib) -> tuple[int, int]:
     return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values()), built.products
 
 
+def baseline() -> dict:
+    """Per PLA name the recorded measurements of before (empty without the file)."""
+    if not BASELINE.exists():
+        return {}
+    return json.loads(BASELINE.read_text())["plas"]
+
+
 def run(paths: list[Path]) -> list[dict]:
     lib = load_library()
+    base = baseline()
     out = []
     for path in paths:
         spec = parse_pla_file(path)
@@ -108,27 +120,38 @@ def run(paths: list[Path]) -> list[dict]:
                "limited": len(eq.time_limited),
                "before_products": before.products, "before_s": before_seconds,
                "parts_before": mapped(before, lib)[0], "parts_after": parts_after,
-               "built_products": built}
+               "built_products": built,
+               "parts_baseline": base.get(path.stem, {}).get("parts"),
+               "seconds_baseline": base.get(path.stem, {}).get("seconds"),
+               "cpu_baseline": base.get(path.stem, {}).get("cpu"),
+               "time_limited": list(eq.time_limited)}
         out.append(row)
         print(f"{row['name']:>10} {row['inputs']:>3} {row['outputs']:>3} "
               f"products {row['products']:>4} (espresso {esp}, before {row['before_products']})"
               f" {seconds:6.2f} s (cpu {cpu:.2f} s){' proven' if eq.proven else ''}"
               f"{f' [{len(eq.time_limited)} time limits]' if eq.time_limited else ''}"
               f"  parts {row['parts_before']} -> {row['parts_after']} "
-              f"(built with {built} products)", flush=True)
+              f"(built with {built} products; before the speed-up {row['parts_baseline']})"
+              f"{' ' + '; '.join(eq.time_limited) if eq.time_limited else ''}", flush=True)
     return out
 
 
 def markdown(rows: list[dict]) -> str:
     lines = ["| PLA | in | out | mechc products | espresso products | per-output products "
-             "| mechc s | mechc cpu s | proven | parts per-output | parts now | products built |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| mechc s | mechc cpu s | s before (cpu) | proven | parts per-output | parts now "
+             "| parts before | products built |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+
+    def opt(v, fmt="{}"):
+        return "–" if v is None else fmt.format(v)
+
     for r in rows:
         lines.append(f"| {r['name']} | {r['inputs']} | {r['outputs']} | {r['products']} | "
                      f"{r['espresso']} | {r['before_products']} | {r['seconds']:.1f} | "
-                     f"{r['cpu']:.1f} | "
+                     f"{r['cpu']:.1f} | {opt(r['seconds_baseline'], '{:.1f}')} "
+                     f"({opt(r['cpu_baseline'], '{:.1f}')}) | "
                      f"{'yes' if r['proven'] else 'no'} | {r['parts_before']} | "
-                     f"{r['parts_after']} | {r['built_products']} |")
+                     f"{r['parts_after']} | {opt(r['parts_baseline'])} | {r['built_products']} |")
     sources = sorted({r["source"] for r in rows})
     lines.append("")
     lines.append(f"espresso counts: {', '.join(sources)} (pyeda: the original espresso run "
@@ -148,6 +171,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="directory of .pla files (default: the small PLAs of the tests)")
     ap.add_argument("--max-inputs", type=int, default=16)
     ap.add_argument("--only", nargs="*", help="PLA names (file stems) to run")
+    ap.add_argument("--json", metavar="FILE", help="write every row (and the steps whose "
+                    "time limit ran out) to FILE")
     ap.add_argument("--markdown", action="store_true",
                     help="rewrite the table in docs/minimisation.md")
     args = ap.parse_args(argv)
@@ -163,8 +188,13 @@ def main(argv: list[str] | None = None) -> int:
              and r["products"] > r["espresso"]]
     slow = [r["name"] for r in rows if r["seconds"] > 10]
     more_parts = [r["name"] for r in rows if r["parts_after"] > r["parts_before"]]
+    above = [r["name"] for r in rows if r["parts_baseline"] is not None
+             and r["parts_after"] > r["parts_baseline"]]
     print(f"more products than espresso: {worse or 'none'}; over 10 s: {slow or 'none'}; "
-          f"more parts than before: {more_parts or 'none'}")
+          f"more parts than per-output: {more_parts or 'none'}; "
+          f"more parts than before the speed-up: {above or 'none'}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
     if args.markdown:
         write_doc(markdown(rows))
         print(f"wrote the table in {DOC.relative_to(ROOT)}")

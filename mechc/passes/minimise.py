@@ -16,19 +16,17 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy import sparse
 
 from mechc.errors import MechcError, UsageError
 from mechc.ir.equations import Cover, Equations, XorForm
 from mechc.ir.spec import Spec
-from mechc.logic.cover import min_cover, reduce_problem, share_covers, unique_rows
+from mechc.logic.cover import min_cover, share_covers
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
 from mechc.logic.espresso import check_cover, espresso
 from mechc.logic.hazards import hazard_free
-from mechc.logic.implicants import cube_points, own_primes, region_sets, table_fits, ternary_table
+from mechc.logic.implicants import own_primes, region_sets, table_fits, ternary_table
 from mechc.logic.multi import minimise_multi
 from mechc.logic.primes import TooManyPrimes, prime_implicants
-from mechc.logic.setcover import heuristic_cover
 
 
 @dataclass
@@ -42,6 +40,10 @@ class MinimiseOptions:
     multi_output: bool = True  # one set of products for all outputs (fewest distinct products)
     multi_time_limit: float = 5.0  # seconds for the multi-output step (at most time_limit)
     hazard_time_limit: float = 2.0  # seconds per output for the consensus terms (ditto)
+    # seconds of wall time for the whole minimisation of a truth-table spec: the per-output
+    # covers share half of what is left, the multi-output step and the sharing program most
+    # of the rest (None: each step keeps its own limit only)
+    budget: float | None = 8.0
 
 
 def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
@@ -56,15 +58,19 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     limited: list[str] = []
     multi = opts.multi_output and len(spec.outputs) > 1 and spec.kind != "fsm"
     m = len(spec.outputs)
+    clock = _Clock(opts.budget)
     # the mapper's alternatives share one budget, so many outputs do not multiply it
     aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
     tables = np.array([spec.table(o) for o in spec.outputs])
     own = _own_primes(tables != 0, n)  # every output's primes at once (None: too wide)
-    comp_own = _own_primes(tables != 1, n) if opts.complements else None
+    comp_own = _own_primes(tables != 1, n) \
+        if opts.complements and n <= ALT_EXACT_MAX_INPUTS else None
     for i, name in enumerate(spec.outputs):
         table = tables[i]
+        copts = replace(opts, time_limit=min(opts.time_limit, max(
+            MIN_STEP_SECONDS, COVER_SHARE * clock.left() / (m - i))))
         covers[name], prime_sets[name] = _minimise_table(
-            table, n, opts, primes=own[i] if own is not None else None)
+            table, n, copts, primes=own[i] if own is not None else None)
         if not covers[name].proven and covers[name].method != "expand":
             limited.append(f"cover of {name}")
         if opts.complements:
@@ -83,10 +89,12 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     if multi:
         per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
                                eq.xor_forms)
-        limited.extend(_multi_output(spec, eq, opts))
+        limited.extend(_multi_output(spec, eq, replace(opts, multi_time_limit=min(
+            opts.multi_time_limit, max(1.0, MULTI_SHARE * clock.left())))))
         if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
             _share(spec, per_output, prime_sets, replace(opts, time_limit=min(
-                opts.time_limit, opts.multi_time_limit)))
+                opts.time_limit, opts.multi_time_limit,
+                max(MIN_STEP_SECONDS, SHARE_SHARE * clock.left()))), limited)
             for o in eq.outputs:  # not the multi-output minimum, whatever each one is alone
                 c = per_output.covers[o]
                 per_output.covers[o] = Cover(c.cubes, False, "per-output", c.seconds)
@@ -121,6 +129,25 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
         alt.time_limited = limited
     verify(spec, eq)
     return eq
+
+
+#: Shares of the time budget still left: the per-output covers (together), the multi-output
+#: step, the program sharing the per-output covers; no step gets less than
+#: ``MIN_STEP_SECONDS``.
+COVER_SHARE = 0.45
+MULTI_SHARE = 0.6
+SHARE_SHARE = 0.5
+MIN_STEP_SECONDS = 0.3
+
+
+class _Clock:
+    """The wall-clock time left of ``MinimiseOptions.budget`` (infinite without one)."""
+
+    def __init__(self, budget: float | None):
+        self.end = time.perf_counter() + budget if budget else float("inf")
+
+    def left(self) -> float:
+        return max(0.0, self.end - time.perf_counter())
 
 
 def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions) -> list[str]:
@@ -238,28 +265,19 @@ def _useful(masks: np.ndarray, values: np.ndarray, on: np.ndarray):
     return masks[keep], values[keep]
 
 
-#: Local search steps for a mapper alternative's cover over all its primes (a result that
-#: does not depend on how busy the machine is).
-ALT_LOCAL_STEPS = 100
-
-
 def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions,
                   primes: tuple[np.ndarray, np.ndarray] | None = None):
     """A cover for one of the mapper's alternatives (complement, XOR residual): exact when
-    small, otherwise a heuristic prime cover (these are never reported as the minimum): local
-    search over all primes where the ternary table gives them (``primes``, or one built here),
-    else espresso's loop."""
+    small (``primes``: its primes, when already known), otherwise espresso's loop (these are
+    never reported as the minimum). Covering all the complement's primes by local search
+    instead gave fewer terms but more parts (apex4 17,020 against 16,933, sao2 1,075
+    against 1,044): espresso's larger cubes map cheaper."""
     if n <= ALT_EXACT_MAX_INPUTS:
         return _minimise_table(table, n, _alt(opts), primes=primes)
     t0 = time.perf_counter()
     onm = np.flatnonzero(table == 1).astype(np.int64)
     if not len(onm):
         return Cover([], True, "exact", 0.0), None
-    if primes is None:
-        got = _own_primes((table != 0)[None, :], n)
-        primes = got[0] if got is not None else None
-    if primes is not None and len(primes[0]) <= opts.prime_limit:
-        return _local_cover(table, n, primes, onm, opts, t0)
     # espresso starts from cubes, not minterms: greedy primes of the on-set (inside on ∪ dc)
     # and of the dc-set (inside dc). From 24576 minterms (the complement of a two-literal
     # product of 15 inputs) its 3 s ran out before EXPAND had merged them, and the mapper
@@ -273,40 +291,6 @@ def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions,
     method = "espresso" if res.complete else "espresso (time limit)"
     return (Cover(list(res.cubes), False, method, time.perf_counter() - t0),
             (masks, values, onm, dcm))
-
-
-def _local_cover(table: np.ndarray, n: int, primes, onm: np.ndarray, opts: MinimiseOptions,
-                 t0: float):
-    """Fewest primes (then literals) covering the on-minterms: essential columns and
-    dominance, then row weighting local search (``setcover.py``) on what is left."""
-    masks, values = primes
-    dcm = np.flatnonzero(table == DC).astype(np.int64)
-    # each prime's points listed directly (a prime of few literals holds thousands of them;
-    # testing every on-minterm against every prime cost more than the search)
-    cid, pts = cube_points(masks, values, n)
-    rowid = np.full(1 << n, -1, dtype=np.int64)
-    rowid[onm] = np.arange(len(onm))
-    r = rowid[pts]
-    A = sparse.csr_matrix((np.ones(int((r >= 0).sum()), dtype=np.int8), (r[r >= 0], cid[r >= 0])),
-                          shape=(len(onm), len(masks)))
-    useful = np.diff(A.tocsc().indptr) > 0
-    masks, values = masks[useful], values[useful]
-    A = unique_rows(A[:, np.flatnonzero(useful)])
-    lits = np.array([int(x).bit_count() for x in masks], dtype=np.int64)
-    forced, rows, cols = reduce_problem(A, (n + 1) * len(masks) + lits.astype(float))
-    chosen = forced
-    if len(rows):
-        got = heuristic_cover(A[rows][:, cols], lits[cols],
-                              min(opts.time_limit, opts.alt_time_limit),
-                              max_steps=ALT_LOCAL_STEPS, min_steps=ALT_LOCAL_STEPS)
-        chosen = np.concatenate([forced, cols[got]])
-    chosen = np.sort(chosen)
-    cubes = [Cube(int(masks[i]), int(values[i])) for i in chosen]
-    # the consensus terms are then looked for among the cover's own cubes and primes grown
-    # around the pairs it misses (as after espresso): over every prime the program is too
-    # large for its time limit
-    return (Cover(cubes, False, "primes+local search", time.perf_counter() - t0),
-            (masks[chosen], values[chosen], onm, dcm))
 
 
 def _alt(opts: MinimiseOptions) -> MinimiseOptions:
@@ -379,7 +363,8 @@ def _cube_inside(region: np.ndarray, mask: int, value: int, n: int) -> bool:
     return bool(region[_cube_points(mask, value, n)].all())
 
 
-def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None:
+def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions,
+           limited: list[str] | None = None) -> None:
     names = [nm for nm in spec.outputs if prime_sets[nm] is not None]
     if len(names) < 2:
         return
@@ -398,6 +383,8 @@ def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None
                           [(eq.covers[nm].terms, eq.covers[nm].literals) for nm in names],
                           spec.n, opts.time_limit)
     if chosen is None:
+        if limited is not None:
+            limited.append("shared per-output covers")
         return
     new = {nm: [Cube(int(cands[i][0][j]), int(cands[i][1][j])) for j in chosen[i]]
            for i, nm in enumerate(names)}
