@@ -223,3 +223,27 @@ def test_own_primes_match_brute_force_and_recursion(seed):
         assert set(zip(masks.tolist(), values.tolist())) == _brute_primes(region[i], n)
         rm, rv = prime_implicants(region[i])
         assert np.array_equal(masks, rm) and np.array_equal(values, rv)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_cover_out_of_time_is_no_worse_than_greedy(seed):
+    """When the covering program has (almost) no time, min_cover falls back to local search:
+    a cover of every on-minterm (checked here row by row) with no more terms than the
+    classic greedy cover of the same candidates."""
+    from mechc.logic.cover import coverage, greedy_cover, min_cover
+    from mechc.logic.primes import prime_implicants
+    rng = np.random.default_rng(880 + seed)
+    n = 11
+    t = random_table(rng, n, p_on=0.45, p_dc=0.1)
+    on = np.flatnonzero(t == 1).astype(np.int64)
+    dc = np.flatnonzero(t == 2).astype(np.int64)
+    masks, values = prime_implicants(t != 0)
+    res = min_cover(masks, values, on, dc, n, time_limit=1e-3)
+    got = np.zeros(len(on), dtype=bool)
+    for k in res.chosen:
+        got |= (on & masks[k]) == values[k]
+    assert got.all()
+    A = coverage(masks, values, on)
+    lits = np.array([int(x).bit_count() for x in masks])
+    g = greedy_cover(A, 1.0 + lits / (n + 1.0))
+    assert len(res.chosen) <= len(g)
