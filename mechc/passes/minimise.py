@@ -74,14 +74,17 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
         if not covers[name].proven and covers[name].method != "expand":
             limited.append(f"cover of {name}")
         if opts.complements:
+            # the alternatives' limits are CPU work too: scaled by the load seen so far (under
+            # load 10 espresso's 3 s ran out on alu4's f7: 517 more parts)
             comps[name], comp_sets[name] = _minimise_alt(
-                _complement(table), n, aopts, comp_own[i] if comp_own is not None else None)
+                _complement(table), n, _scaled(aopts, clock),
+                comp_own[i] if comp_own is not None else None)
             if comps[name].method == "greedy" or comps[name].method.endswith("(time limit)"):
                 limited.append(f"complement cover of {name} (a mapper alternative)")
     eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
     if opts.complements:
         for name in spec.outputs:
-            xf = _xor_form(spec.table(name), spec.inputs, aopts)
+            xf = _xor_form(spec.table(name), spec.inputs, _scaled(aopts, clock))
             if xf is not None:
                 eq.xor_forms[name] = xf
     if opts.share and len(spec.outputs) > 1 and not multi:  # the multi-output step shares
@@ -102,7 +105,7 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     eq.shared_terms = count_shared(eq)
     if opts.hazard_free:
         hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit,
-                                             max(HAZARD_BUDGET / m, 0.2)))
+                                             max(HAZARD_BUDGET / m, 0.2)) * clock.slowdown())
         # products built for some output: closing a hazard with one costs an OR input only
         built = list(dict.fromkeys(c for o in spec.outputs for c in eq.covers[o].cubes)) \
             if multi else []
@@ -150,13 +153,22 @@ class _Clock:
         self.budget = budget
         self.wall0, self.cpu0 = time.perf_counter(), time.process_time()
 
+    def slowdown(self) -> float:
+        """Wall seconds per CPU second of this call so far (at least 1)."""
+        cpu = time.process_time() - self.cpu0
+        wall = time.perf_counter() - self.wall0
+        return max(1.0, wall / cpu) if cpu > 0.05 else 1.0
+
     def left(self) -> float:
         if not self.budget:
             return float("inf")
-        cpu = time.process_time() - self.cpu0
-        wall = time.perf_counter() - self.wall0
-        slowdown = max(1.0, wall / cpu) if cpu > 0.05 else 1.0
-        return max(0.0, self.budget - cpu) * slowdown
+        return max(0.0, self.budget - (time.process_time() - self.cpu0)) * self.slowdown()
+
+
+def _scaled(opts: MinimiseOptions, clock: _Clock) -> MinimiseOptions:
+    """The alternatives' time limits stretched by the slowdown seen so far."""
+    f = clock.slowdown()
+    return replace(opts, time_limit=opts.time_limit * f, alt_time_limit=opts.alt_time_limit * f)
 
 
 def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions) -> list[str]:
