@@ -92,11 +92,15 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     if multi:
         per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
                                eq.xor_forms)
-        limited.extend(_multi_output(spec, eq, replace(opts, multi_time_limit=min(
-            opts.multi_time_limit, max(1.0, MULTI_SHARE * clock.left())))))
+        # their own caps are CPU work too (stretched like the budget)
+        slow = clock.slowdown()
+        limited.extend(_multi_output(spec, eq, replace(
+            opts, time_limit=opts.time_limit * slow, multi_time_limit=min(
+                opts.multi_time_limit * slow, max(1.0, MULTI_SHARE * clock.left())))))
         if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
+            slow = clock.slowdown()
             _share(spec, per_output, prime_sets, replace(opts, time_limit=min(
-                opts.time_limit, opts.multi_time_limit,
+                opts.time_limit * slow, opts.multi_time_limit * slow,
                 max(MIN_STEP_SECONDS, SHARE_SHARE * clock.left()))), limited)
             for o in eq.outputs:  # not the multi-output minimum, whatever each one is alone
                 c = per_output.covers[o]
