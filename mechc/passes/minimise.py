@@ -147,6 +147,10 @@ SHARE_SHARE = 0.5
 MIN_STEP_SECONDS = 0.3
 
 
+SLOWDOWN_CAP = 2.5
+SLOWDOWN_MIN_CPU = 0.3
+
+
 class _Clock:
     """What is left of ``MinimiseOptions.budget``, counted in CPU seconds of this process
     (the same work on an idle machine or on one shared with other jobs) and handed out as
@@ -158,10 +162,14 @@ class _Clock:
         self.wall0, self.cpu0 = time.perf_counter(), time.process_time()
 
     def slowdown(self) -> float:
-        """Wall seconds per CPU second of this call so far (at least 1)."""
+        """Wall seconds per CPU second of this call so far, between 1 and ``SLOWDOWN_CAP``
+        (1 until ``SLOWDOWN_MIN_CPU`` has run: a short stall made alu4's multi-output step
+        take 18 s stretched limits once the machine went quiet)."""
         cpu = time.process_time() - self.cpu0
         wall = time.perf_counter() - self.wall0
-        return max(1.0, wall / cpu) if cpu > 0.05 else 1.0
+        if cpu < SLOWDOWN_MIN_CPU:
+            return 1.0
+        return min(SLOWDOWN_CAP, max(1.0, wall / cpu))
 
     def left(self) -> float:
         if not self.budget:
