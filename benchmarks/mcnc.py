@@ -9,14 +9,17 @@ espresso through pyeda (``pip install -e '.[bench]'``), or, where pyeda is not i
 published count from the table below; and the parts of the mapped design (AND/OR/NOT-family
 cells, before amplifiers) with the per-output minimiser of before multi-output minimisation
 (``multi_output=False``) and with the default one. Every cover is checked against the spec on
-every vector by the minimiser itself. ``--markdown`` rewrites the table in
-docs/minimisation.md. The MCNC PLAs (the LGSynth'91 two-level suite) are not shipped with mechc.
+every vector by the minimiser itself, and the mapped design of the default one is simulated
+on every input vector against the spec (the run stops at a mismatch). ``--markdown``
+rewrites the table in docs/minimisation.md. The MCNC PLAs (the LGSynth'91 two-level suite)
+are not shipped with mechc.
 Exit status 1 if mechc has more products than espresso on any PLA.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -25,9 +28,13 @@ from mechc.cells.library import load_library
 from mechc.frontends.pla import parse_pla_file
 from mechc.passes.map import map_equations
 from mechc.passes.minimise import MinimiseOptions, minimise
+from mechc.proofs.logic import prove_logic
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "minimisation.md"
+#: The same measurements before the minimiser's speed-up (products, parts, seconds per PLA):
+#: the reference for "no more parts than before".
+BASELINE = Path(__file__).with_name("mcnc_baseline.json")
 BEGIN, END = "<!-- mcnc table begin -->", "<!-- mcnc table end -->"
 #: espresso's product counts on the MCNC PLAs (multi-output heuristic cover), used only when
 #: pyeda is not installed.
@@ -81,16 +88,30 @@ def espresso_products(path: Path) -> tuple[int | None, float, str]:
     return len({inp for inp, _ in cover}), time.perf_counter() - t0, "pyeda"
 
 
-def mapped(eq, lib) -> tuple[int, int]:
+def mapped(eq, lib, spec=None) -> tuple[int, int]:
     """(parts, distinct products) of the design the mapper builds (it may take the
-    per-output covers the equations carry as their alternative, where those cost fewer)."""
+    per-output covers the equations carry as their alternative, where those cost fewer).
+    With ``spec`` the mapped netlist is also simulated on every input vector against it."""
     m = map_equations(eq, lib)
     built = m.equations if m.equations is not None else eq
+    if spec is not None:
+        report = prove_logic(m.netlist, spec, method="exhaustive")
+        if not report.passed:
+            raise SystemExit(f"{spec.path}: mapped design differs from the spec: "
+                             f"{report.failures[:1]}")
     return sum(lib[c.cell].cost(len(c.inputs)) for c in m.netlist.cells.values()), built.products
+
+
+def baseline() -> dict:
+    """Per PLA name the recorded measurements of before (empty without the file)."""
+    if not BASELINE.exists():
+        return {}
+    return json.loads(BASELINE.read_text())["plas"]
 
 
 def run(paths: list[Path]) -> list[dict]:
     lib = load_library()
+    base = baseline()
     out = []
     for path in paths:
         spec = parse_pla_file(path)
@@ -101,34 +122,45 @@ def run(paths: list[Path]) -> list[dict]:
         before = minimise(spec, MinimiseOptions(multi_output=False))
         before_seconds = time.perf_counter() - t1
         esp, esp_s, source = espresso_products(path)
-        parts_after, built = mapped(eq, lib)
+        parts_after, built = mapped(eq, lib, spec)  # simulated on every vector
         row = {"name": path.stem, "inputs": spec.n, "outputs": len(spec.outputs),
                "products": eq.products, "espresso": esp, "espresso_s": esp_s, "source": source,
                "seconds": seconds, "cpu": cpu, "proven": eq.proven,
                "limited": len(eq.time_limited),
                "before_products": before.products, "before_s": before_seconds,
                "parts_before": mapped(before, lib)[0], "parts_after": parts_after,
-               "built_products": built}
+               "built_products": built,
+               "parts_baseline": base.get(path.stem, {}).get("parts"),
+               "seconds_baseline": base.get(path.stem, {}).get("seconds"),
+               "cpu_baseline": base.get(path.stem, {}).get("cpu"),
+               "time_limited": list(eq.time_limited)}
         out.append(row)
         print(f"{row['name']:>10} {row['inputs']:>3} {row['outputs']:>3} "
               f"products {row['products']:>4} (espresso {esp}, before {row['before_products']})"
               f" {seconds:6.2f} s (cpu {cpu:.2f} s){' proven' if eq.proven else ''}"
               f"{f' [{len(eq.time_limited)} time limits]' if eq.time_limited else ''}"
               f"  parts {row['parts_before']} -> {row['parts_after']} "
-              f"(built with {built} products)", flush=True)
+              f"(built with {built} products; before the speed-up {row['parts_baseline']})"
+              f"{' ' + '; '.join(eq.time_limited) if eq.time_limited else ''}", flush=True)
     return out
 
 
 def markdown(rows: list[dict]) -> str:
     lines = ["| PLA | in | out | mechc products | espresso products | per-output products "
-             "| mechc s | mechc cpu s | proven | parts per-output | parts now | products built |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| mechc s | mechc cpu s | s before (cpu) | proven | parts per-output | parts now "
+             "| parts before | products built |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+
+    def opt(v, fmt="{}"):
+        return "–" if v is None else fmt.format(v)
+
     for r in rows:
         lines.append(f"| {r['name']} | {r['inputs']} | {r['outputs']} | {r['products']} | "
                      f"{r['espresso']} | {r['before_products']} | {r['seconds']:.1f} | "
-                     f"{r['cpu']:.1f} | "
+                     f"{r['cpu']:.1f} | {opt(r['seconds_baseline'], '{:.1f}')} "
+                     f"({opt(r['cpu_baseline'], '{:.1f}')}) | "
                      f"{'yes' if r['proven'] else 'no'} | {r['parts_before']} | "
-                     f"{r['parts_after']} | {r['built_products']} |")
+                     f"{r['parts_after']} | {opt(r['parts_baseline'])} | {r['built_products']} |")
     sources = sorted({r["source"] for r in rows})
     lines.append("")
     lines.append(f"espresso counts: {', '.join(sources)} (pyeda: the original espresso run "
@@ -148,6 +180,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="directory of .pla files (default: the small PLAs of the tests)")
     ap.add_argument("--max-inputs", type=int, default=16)
     ap.add_argument("--only", nargs="*", help="PLA names (file stems) to run")
+    ap.add_argument("--json", metavar="FILE", help="write every row (and the steps whose "
+                    "time limit ran out) to FILE")
     ap.add_argument("--markdown", action="store_true",
                     help="rewrite the table in docs/minimisation.md")
     args = ap.parse_args(argv)
@@ -163,8 +197,13 @@ def main(argv: list[str] | None = None) -> int:
              and r["products"] > r["espresso"]]
     slow = [r["name"] for r in rows if r["seconds"] > 10]
     more_parts = [r["name"] for r in rows if r["parts_after"] > r["parts_before"]]
+    above = [r["name"] for r in rows if r["parts_baseline"] is not None
+             and r["parts_after"] > r["parts_baseline"]]
     print(f"more products than espresso: {worse or 'none'}; over 10 s: {slow or 'none'}; "
-          f"more parts than before: {more_parts or 'none'}")
+          f"more parts than per-output: {more_parts or 'none'}; "
+          f"more parts than before the speed-up: {above or 'none'}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
     if args.markdown:
         write_doc(markdown(rows))
         print(f"wrote the table in {DOC.relative_to(ROOT)}")

@@ -24,6 +24,7 @@ from mechc.logic.cover import min_cover, share_covers
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
 from mechc.logic.espresso import check_cover, espresso
 from mechc.logic.hazards import hazard_free
+from mechc.logic.implicants import own_primes, region_sets, table_fits, ternary_table
 from mechc.logic.multi import minimise_multi
 from mechc.logic.primes import TooManyPrimes, prime_implicants
 
@@ -39,6 +40,10 @@ class MinimiseOptions:
     multi_output: bool = True  # one set of products for all outputs (fewest distinct products)
     multi_time_limit: float = 5.0  # seconds for the multi-output step (at most time_limit)
     hazard_time_limit: float = 2.0  # seconds per output for the consensus terms (ditto)
+    # CPU seconds for the whole minimisation of a truth-table spec (see ``_Clock``): the
+    # per-output covers share 45 % of what is left, the multi-output step and the sharing
+    # program most of the rest (None: each step keeps its own limit only)
+    budget: float | None = 7.0
 
 
 def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
@@ -53,21 +58,33 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     limited: list[str] = []
     multi = opts.multi_output and len(spec.outputs) > 1 and spec.kind != "fsm"
     m = len(spec.outputs)
+    clock = _Clock(opts.budget)
     # the mapper's alternatives share one budget, so many outputs do not multiply it
     aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
-    for name in spec.outputs:
-        table = spec.table(name)
-        covers[name], prime_sets[name] = _minimise_table(table, n, opts)
+    tables = np.array([spec.table(o) for o in spec.outputs])
+    own = _own_primes(tables != 0, n)  # every output's primes at once (None: too wide)
+    comp_own = _own_primes(tables != 1, n) \
+        if opts.complements and n <= ALT_EXACT_MAX_INPUTS else None
+    for i, name in enumerate(spec.outputs):
+        table = tables[i]
+        copts = replace(opts, time_limit=min(opts.time_limit, max(
+            MIN_STEP_SECONDS, COVER_SHARE * clock.left() / (m - i))))
+        covers[name], prime_sets[name] = _minimise_table(
+            table, n, copts, primes=own[i] if own is not None else None)
         if not covers[name].proven and covers[name].method != "expand":
             limited.append(f"cover of {name}")
         if opts.complements:
-            comps[name], comp_sets[name] = _minimise_alt(_complement(table), n, aopts)
+            # the alternatives' limits are CPU work too: scaled by the load seen so far (under
+            # load 10 espresso's 3 s ran out on alu4's f7: 517 more parts)
+            comps[name], comp_sets[name] = _minimise_alt(
+                _complement(table), n, _scaled(aopts, clock),
+                comp_own[i] if comp_own is not None else None)
             if comps[name].method == "greedy" or comps[name].method.endswith("(time limit)"):
                 limited.append(f"complement cover of {name} (a mapper alternative)")
     eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
     if opts.complements:
         for name in spec.outputs:
-            xf = _xor_form(spec.table(name), spec.inputs, aopts)
+            xf = _xor_form(spec.table(name), spec.inputs, _scaled(aopts, clock))
             if xf is not None:
                 eq.xor_forms[name] = xf
     if opts.share and len(spec.outputs) > 1 and not multi:  # the multi-output step shares
@@ -75,10 +92,16 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     if multi:
         per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
                                eq.xor_forms)
-        limited.extend(_multi_output(spec, eq, opts))
+        # their own caps are CPU work too (stretched like the budget)
+        slow = clock.slowdown()
+        limited.extend(_multi_output(spec, eq, replace(
+            opts, time_limit=opts.time_limit * slow, multi_time_limit=min(
+                opts.multi_time_limit * slow, max(1.0, MULTI_SHARE * clock.left())))))
         if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
+            slow = clock.slowdown()
             _share(spec, per_output, prime_sets, replace(opts, time_limit=min(
-                opts.time_limit, opts.multi_time_limit)))
+                opts.time_limit * slow, opts.multi_time_limit * slow,
+                max(MIN_STEP_SECONDS, SHARE_SHARE * clock.left()))), limited)
             for o in eq.outputs:  # not the multi-output minimum, whatever each one is alone
                 c = per_output.covers[o]
                 per_output.covers[o] = Cover(c.cubes, False, "per-output", c.seconds)
@@ -86,7 +109,7 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     eq.shared_terms = count_shared(eq)
     if opts.hazard_free:
         hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit,
-                                             max(HAZARD_BUDGET / m, 0.2)))
+                                             max(HAZARD_BUDGET / m, 0.2)) * clock.slowdown())
         # products built for some output: closing a hazard with one costs an OR input only
         built = list(dict.fromkeys(c for o in spec.outputs for c in eq.covers[o].cubes)) \
             if multi else []
@@ -113,6 +136,51 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
         alt.time_limited = limited
     verify(spec, eq)
     return eq
+
+
+#: Shares of the time budget still left: the per-output covers (together), the multi-output
+#: step, the program sharing the per-output covers; no step gets less than
+#: ``MIN_STEP_SECONDS``.
+COVER_SHARE = 0.45
+MULTI_SHARE = 0.6
+SHARE_SHARE = 0.5
+MIN_STEP_SECONDS = 0.3
+
+
+SLOWDOWN_CAP = 2.5
+SLOWDOWN_MIN_CPU = 0.3
+
+
+class _Clock:
+    """What is left of ``MinimiseOptions.budget``, counted in CPU seconds of this process
+    (the same work on an idle machine or on one shared with other jobs) and handed out as
+    wall-clock seconds (the solvers' limits are wall clock): the CPU seconds left times how
+    much slower than the CPU the wall clock has run so far. Infinite without a budget."""
+
+    def __init__(self, budget: float | None):
+        self.budget = budget
+        self.wall0, self.cpu0 = time.perf_counter(), time.process_time()
+
+    def slowdown(self) -> float:
+        """Wall seconds per CPU second of this call so far, between 1 and ``SLOWDOWN_CAP``
+        (1 until ``SLOWDOWN_MIN_CPU`` has run: a short stall made alu4's multi-output step
+        take 18 s stretched limits once the machine went quiet)."""
+        cpu = time.process_time() - self.cpu0
+        wall = time.perf_counter() - self.wall0
+        if cpu < SLOWDOWN_MIN_CPU:
+            return 1.0
+        return min(SLOWDOWN_CAP, max(1.0, wall / cpu))
+
+    def left(self) -> float:
+        if not self.budget:
+            return float("inf")
+        return max(0.0, self.budget - (time.process_time() - self.cpu0)) * self.slowdown()
+
+
+def _scaled(opts: MinimiseOptions, clock: _Clock) -> MinimiseOptions:
+    """The alternatives' time limits stretched by the slowdown seen so far."""
+    f = clock.slowdown()
+    return replace(opts, time_limit=opts.time_limit * f, alt_time_limit=opts.alt_time_limit * f)
 
 
 def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions) -> list[str]:
@@ -144,26 +212,47 @@ def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
     return len(distinct), sum(c.literals() for c in distinct) + sum(len(x) for x in covers)
 
 
-def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions, deadline: bool = False):
+#: Every output's primes come from one ternary table (``implicants.own_primes``) up to this
+#: many cubes (3**15: 14 million entries, a fraction of a second); beyond, per output by the
+#: Shannon recursion of ``primes.py``.
+OWN_TABLE_MAX_CUBES = 3 ** 15
+
+
+def _own_primes(regions: np.ndarray, n: int) -> list | None:
+    """Each row's primes from one ternary table, or None when the table would be too big."""
+    m = regions.shape[0]
+    if 3 ** n > OWN_TABLE_MAX_CUBES or not table_fits(n, m):
+        return None
+    return own_primes(ternary_table(region_sets(regions), n, m), n, m)
+
+
+def _minimise_table(table: np.ndarray, n: int, opts: MinimiseOptions, deadline: bool = False,
+                    primes: tuple[np.ndarray, np.ndarray] | None = None):
     """Exact cover of one output (primes, then the covering program). With ``deadline`` the
     time limit also bounds the prime generation (a start for the multi-output step), past
-    which primes are grown from the on-minterms instead (method ``expand``)."""
+    which primes are grown from the on-minterms instead (method ``expand``). ``primes``: the
+    output's primes already known (from ``_own_primes``)."""
     t0 = time.perf_counter()
     on = np.flatnonzero(table == 1).astype(np.int64)
     dc = np.flatnonzero(table == DC).astype(np.int64)
     if len(on) == 0:
         return Cover([], True, "exact", time.perf_counter() - t0), None
     region = table != 0
-    try:
-        masks, values = prime_implicants(region, limit=opts.prime_limit,
-                                         deadline=t0 + opts.time_limit if deadline else None)
-        method_note = None
-    except TooManyPrimes:
-        masks, values = expand_primes(region, on, n)
-        method_note = "expand"
+    method_note = None
+    if primes is not None and len(primes[0]) <= opts.prime_limit:
+        masks, values = primes
+    else:
+        try:
+            if primes is not None:
+                raise TooManyPrimes(len(primes[0]))
+            masks, values = prime_implicants(region, limit=opts.prime_limit,
+                                             deadline=t0 + opts.time_limit if deadline
+                                             else None)
+        except TooManyPrimes:
+            masks, values = expand_primes(region, on, n)
+            method_note = "expand"
     # candidates that cover at least one on-minterm
-    useful = np.array([bool(((on & m) == v).any()) for m, v in zip(masks, values)], dtype=bool)
-    masks, values = masks[useful], values[useful]
+    masks, values = _useful(masks, values, on)
     res = min_cover(masks, values, on, dc, n, opts.time_limit)
     cubes = [Cube(int(masks[i]), int(values[i])) for i in res.chosen]
     proven = res.proven and method_note is None
@@ -198,11 +287,26 @@ ALT_BUDGET = 24.0
 HAZARD_BUDGET = 2.0
 
 
-def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions):
+def _useful(masks: np.ndarray, values: np.ndarray, on: np.ndarray):
+    """The candidate cubes that cover at least one on-minterm."""
+    if len(masks) == 0:
+        return masks, values
+    keep = np.zeros(len(masks), dtype=bool)
+    step = max(1, 4_000_000 // len(masks))
+    for a in range(0, len(on), step):
+        keep |= ((on[a:a + step, None] & masks[None, :]) == values[None, :]).any(axis=0)
+    return masks[keep], values[keep]
+
+
+def _minimise_alt(table: np.ndarray, n: int, opts: MinimiseOptions,
+                  primes: tuple[np.ndarray, np.ndarray] | None = None):
     """A cover for one of the mapper's alternatives (complement, XOR residual): exact when
-    small, otherwise a heuristic prime cover (these are never reported as the minimum)."""
+    small (``primes``: its primes, when already known), otherwise espresso's loop (these are
+    never reported as the minimum). Covering all the complement's primes by local search
+    instead gave fewer terms but more parts (apex4 17,020 against 16,933, sao2 1,075
+    against 1,044): espresso's larger cubes map cheaper."""
     if n <= ALT_EXACT_MAX_INPUTS:
-        return _minimise_table(table, n, _alt(opts))
+        return _minimise_table(table, n, _alt(opts), primes=primes)
     t0 = time.perf_counter()
     onm = np.flatnonzero(table == 1).astype(np.int64)
     if not len(onm):
@@ -292,7 +396,8 @@ def _cube_inside(region: np.ndarray, mask: int, value: int, n: int) -> bool:
     return bool(region[_cube_points(mask, value, n)].all())
 
 
-def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None:
+def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions,
+           limited: list[str] | None = None) -> None:
     names = [nm for nm in spec.outputs if prime_sets[nm] is not None]
     if len(names) < 2:
         return
@@ -311,6 +416,8 @@ def _share(spec: Spec, eq: Equations, prime_sets, opts: MinimiseOptions) -> None
                           [(eq.covers[nm].terms, eq.covers[nm].literals) for nm in names],
                           spec.n, opts.time_limit)
     if chosen is None:
+        if limited is not None:
+            limited.append("shared per-output covers")
         return
     new = {nm: [Cube(int(cands[i][0][j]), int(cands[i][1][j])) for j in chosen[i]]
            for i, nm in enumerate(names)}

@@ -187,3 +187,63 @@ def test_wide_fallback_without_the_table_is_right_on_every_vector(seed, monkeypa
             assert region[i][inside].all()
             got |= inside
         assert (got | ~on[i]).all()
+
+
+def _brute_primes(region: np.ndarray, n: int) -> set[tuple[int, int]]:
+    """Every maximal cube inside ``region`` by enumeration of all 3**n cubes."""
+    inside = set()
+    for digits in itertools.product((0, 1, 2), repeat=n):
+        mask = sum(1 << (n - 1 - k) for k, d in enumerate(digits) if d != 2)
+        value = sum(1 << (n - 1 - k) for k, d in enumerate(digits) if d == 1)
+        pts = [x for x in range(1 << n) if x & mask == value]
+        if all(region[x] for x in pts):
+            inside.add((mask, value))
+    primes = set()
+    for mask, value in inside:
+        parents = [(mask & ~(1 << b), value & ~(1 << b)) for b in range(n) if mask >> b & 1]
+        if not any(p in inside for p in parents):
+            primes.add((mask, value))
+    return primes
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_own_primes_match_brute_force_and_recursion(seed):
+    """Every output's own primes read off one ternary table are exactly the maximal cubes
+    of its region (enumeration) and what the Shannon recursion gives, in the same order."""
+    from mechc.logic.implicants import own_primes, region_sets
+    from mechc.logic.primes import prime_implicants
+    rng = np.random.default_rng(9100 + seed)
+    n = int(rng.integers(1, 6))
+    m = int(rng.integers(1, 5))
+    _tables, _on, region = _regions(rng, n, m)
+    got = own_primes(ternary_table(region_sets(region), n, m), n, m)
+    assert len(got) == m
+    for i in range(m):
+        masks, values = got[i]
+        assert set(zip(masks.tolist(), values.tolist())) == _brute_primes(region[i], n)
+        rm, rv = prime_implicants(region[i])
+        assert np.array_equal(masks, rm) and np.array_equal(values, rv)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_cover_out_of_time_is_no_worse_than_greedy(seed):
+    """When the covering program has (almost) no time, min_cover falls back to local search:
+    a cover of every on-minterm (checked here row by row) with no more terms than the
+    classic greedy cover of the same candidates."""
+    from mechc.logic.cover import coverage, greedy_cover, min_cover
+    from mechc.logic.primes import prime_implicants
+    rng = np.random.default_rng(880 + seed)
+    n = 11
+    t = random_table(rng, n, p_on=0.45, p_dc=0.1)
+    on = np.flatnonzero(t == 1).astype(np.int64)
+    dc = np.flatnonzero(t == 2).astype(np.int64)
+    masks, values = prime_implicants(t != 0)
+    res = min_cover(masks, values, on, dc, n, time_limit=1e-3)
+    got = np.zeros(len(on), dtype=bool)
+    for k in res.chosen:
+        got |= (on & masks[k]) == values[k]
+    assert got.all()
+    A = coverage(masks, values, on)
+    lits = np.array([int(x).bit_count() for x in masks])
+    g = greedy_cover(A, 1.0 + lits / (n + 1.0))
+    assert len(res.chosen) <= len(g)
