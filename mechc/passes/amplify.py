@@ -32,7 +32,7 @@ from mechc.cells.library import Library
 from mechc.errors import DesignError
 from mechc.ir.mechanism import Demand, SynthContext
 from mechc.ir.netlist import CellInst, Netlist
-from mechc.passes.assemble import MechOptions, synth_context
+from mechc.passes.assemble import MechOptions, synth_context, synthesise_cell
 from mechc.passes.strength import cell_holds, force_ceiling, strength_checks
 
 #: Used when the library's AMPLIFIER does not state how many loads it may drive.
@@ -261,8 +261,8 @@ def _asks(cls, cell: CellInst | None, ctx, demand: Demand,
     included, when it must deliver ``demand``; ``check``: None if the cell alone then fails
     a strength check."""
     n = len(cell.inputs) if cell is not None else 1
-    part = cls.synthesise(cell.id if cell else "amp", ctx, n, dict(cell.params) if cell else {},
-                          demand)
+    part = synthesise_cell(cls, cell.id if cell else "amp", ctx, n,
+                           dict(cell.params) if cell else {}, demand)
     pins = cls.input_names(n)
     asks = [Demand(part.data["input_loads"][p]["right_N"] + ctx.friction,
                    part.data["input_loads"][p]["left_N"] + ctx.friction) for p in pins]

@@ -57,6 +57,17 @@ def synth_context(opts: MechOptions) -> SynthContext:
                         overtravel=opts.overtravel, angle_margin=opts.angle_margin)
 
 
+
+def synthesise_cell(cls, cid: str, ctx: SynthContext, n: int, params: dict, d: Demand) -> Part:
+    """``cls.synthesise``, with a cell that has no geometry (a user cell written without
+    ``synthesise``) named as a usage error rather than an internal one."""
+    try:
+        return cls.synthesise(cid, ctx, n, params, d)
+    except NotImplementedError:
+        raise UsageError(f"cell '{cls.name}' ({cls.source}) has no mechanism: implement "
+                         "synthesise() (see docs/write-a-cell.md)") from None
+
+
 def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
                          opts: MechOptions | None = None) -> Mechanism:
     opts = opts or MechOptions()
@@ -183,11 +194,7 @@ def _size_cells(order, cells, lib, ctx, opts, out_nets, loads, before):
         prev = before.get(c.outputs[0])
         if prev is not None:
             d = Demand(max(d.right, prev.right), max(d.left, prev.left))
-        try:
-            part = cls.synthesise(cid, ctx, len(c.inputs), c.params, d)
-        except NotImplementedError:
-            raise UsageError(f"cell '{c.cell}' ({cls.source}) has no mechanism: implement "
-                             "synthesise() (see docs/write-a-cell.md)") from None
+        part = synthesise_cell(cls, cid, ctx, len(c.inputs), c.params, d)
         part.data["output_demand"] = d.to_json()
         local[cid] = part
         for net, pin in zip(c.inputs, cls.input_names(len(c.inputs))):
