@@ -222,13 +222,17 @@ def size_pins(mech: Mechanism, loads: dict[str, float]) -> None:
     """Give every pin joint and every fixed pivot of each part the pin its load needs."""
     ctx = mech.ctx
     for where, part in _parts(mech):
-        d = pin_diameter(loads.get(where, 0.0), ctx)
-        for j in part.joints:
-            if j.kind in PIN_JOINTS:
-                j.pin_diameter = d
-        for b in part.bodies:
-            if b.kind in PIVOTED:
-                b.pin_diameter = d
+        set_pins(part, pin_diameter(loads.get(where, 0.0), ctx))
+
+
+def set_pins(part: Part, d: float) -> None:
+    """Every pin joint and every fixed pivot of ``part`` gets a pin of diameter ``d`` (mm)."""
+    for j in part.joints:
+        if j.kind in PIN_JOINTS:
+            j.pin_diameter = d
+    for b in part.bodies:
+        if b.kind in PIVOTED:
+            b.pin_diameter = d
 
 
 def lever_arm(part: Part, lever: str, pivot: tuple[float, float]) -> float:
@@ -299,13 +303,7 @@ def cell_holds(where: str, part: Part, load: float, ctx: SynthContext) -> bool:
     """Whether a cell's part, alone, passes its strength checks under ``load`` (its pins
     sized for it, its own rods unguided): how the amplifier planner asks whether a cell can
     drive a net's demand before the mechanism is assembled."""
-    d = pin_diameter(load, ctx)
-    for j in part.joints:
-        if j.kind in PIN_JOINTS:
-            j.pin_diameter = d
-    for b in part.bodies:
-        if b.kind in PIVOTED:
-            b.pin_diameter = d
+    set_pins(part, pin_diameter(load, ctx))
     if not all(c.passed for c in part_checks(where, part, load, ctx)):
         return False
     E = material(ctx.material).E
