@@ -130,6 +130,19 @@ def test_heuristic_cover_keeps_a_good_start():
     assert D[:, got].any(axis=1).all() and len(got) <= len(g)
 
 
+def _assert_right_on_care_vectors(res, n: int, m: int, on, region) -> None:
+    """Every cube of every output's cover lies inside that output's region (on-set or
+    don't-care) and the cover holds every on-set vector: checked by enumeration."""
+    idx = np.arange(1 << n)
+    for i in range(m):
+        got = np.zeros(1 << n, dtype=bool)
+        for c in res.output_cubes(i):
+            inside = (idx & c.mask) == c.value
+            assert region[i][inside].all()
+            got |= inside
+        assert (got | ~on[i]).all()
+
+
 @pytest.mark.parametrize("seed", range(10))
 def test_table_engine_heuristic_route_is_right_on_every_vector(seed):
     """With a prime limit of 1 the table engine skips the exact program (local search and
@@ -140,14 +153,7 @@ def test_table_engine_heuristic_route_is_right_on_every_vector(seed):
     tables, on, region = _regions(rng, n, m)
     res = minimise_multi(n, on, region, [[] for _ in range(m)], time_limit=2.0, prime_limit=1)
     assert not res.proven
-    idx = np.arange(1 << n)
-    for i in range(m):
-        got = np.zeros(1 << n, dtype=bool)
-        for c in res.output_cubes(i):
-            inside = (idx & c.mask) == c.value
-            assert region[i][inside].all()
-            got |= inside
-        assert (got | ~on[i]).all()
+    _assert_right_on_care_vectors(res, n, m, on, region)
 
 
 @pytest.mark.parametrize("seed", range(6))
@@ -179,14 +185,7 @@ def test_wide_fallback_without_the_table_is_right_on_every_vector(seed, monkeypa
     full = (1 << n) - 1
     start = [[Cube(full, int(x)) for x in np.flatnonzero(on[i])] for i in range(m)]
     res = minimise_multi(n, on, region, start, time_limit=2.0, prime_limit=1)
-    idx = np.arange(1 << n)
-    for i in range(m):
-        got = np.zeros(1 << n, dtype=bool)
-        for c in res.output_cubes(i):
-            inside = (idx & c.mask) == c.value
-            assert region[i][inside].all()
-            got |= inside
-        assert (got | ~on[i]).all()
+    _assert_right_on_care_vectors(res, n, m, on, region)
 
 
 def _brute_primes(region: np.ndarray, n: int) -> set[tuple[int, int]]:
