@@ -45,10 +45,10 @@ import numpy as np
 from mechc.cells.characterise import SETTLED, CellTable
 from mechc.cells.library import Library
 from mechc.ir.design import Design
-from mechc.ir.logic_types import evaluate_type, table_rows
 from mechc.ir.netlist import Netlist
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
+from mechc.ir.ternary import evaluate3
 from mechc.logic.cubes import DC
 from mechc.physics.scene import DynSettings
 from mechc.proofs.dynamic import dynamic_engine, plan_changes, prove_dynamic
@@ -74,8 +74,6 @@ HELD_MARGIN_SHARE = 0.5
 #: the changes the screen chose to run (contact overrun, random23; ``benchmarks/screen.py``),
 #: times 1.5, rounded up.
 SOLVER_FACTOR = 6.0
-#: A cell with more inputs than this is not simulated in ternary: its output is unknown.
-TERNARY_MAX_FANIN = 12
 #: Per-change decisions kept in the report.
 MAX_LISTED = 200
 
@@ -91,8 +89,8 @@ def screened_engine(design: Design, spec: Spec, lib: Library, settings: ProofSet
         why = "a pose trace records every change"
     elif settings.prune:
         why = "--prune asks for per-change pruned scenes"
-    elif blocker(design.netlist, lib) is not None:
-        why = blocker(design.netlist, lib)
+    else:
+        why = blocker(design.netlist, lib)  # a design that holds state, or None
     if why is not None:
         return _unscreened(dynamic_engine(design, spec, lib, settings, progress), why)
     return prove_screened(design, spec, lib, settings, progress)
@@ -308,37 +306,16 @@ def _merge(a: ProofReport, b: ProofReport) -> ProofReport:
 def held_by_logic(nl: Netlist, names: list[str], pairs: list[tuple[int, int]]
                   ) -> dict[str, np.ndarray]:
     """Per output and change: whether the output is the same for every order in which the
-    cells can switch — the moving input unknown (X), each cell's output known only where
-    every completion of its unknown inputs agrees (ternary simulation; a definite output has
-    no static hazard under any cell delays)."""
+    cells can switch — the moving input unknown (X), ternary simulation (a definite output
+    has no static hazard under any cell delays)."""
     n = len(names)
-    m = len(pairs)
-    can0: dict[str, np.ndarray] = {}
-    can1: dict[str, np.ndarray] = {}
+    vals = {}
     for k, nm in enumerate(names):
         a = np.array([(c >> (n - 1 - k)) & 1 for c, _ in pairs], dtype=bool)
         b = np.array([(v >> (n - 1 - k)) & 1 for _, v in pairs], dtype=bool)
-        can0[nm] = ~a | ~b
-        can1[nm] = a | b
-    for c in nl.topo_cells():
-        k = len(c.inputs)
-        if k > TERNARY_MAX_FANIN or not c.outputs:
-            z = np.ones(m, dtype=bool)
-            for net in c.outputs:
-                can0[net], can1[net] = z, z
-            continue
-        rows = table_rows(k)
-        out = np.asarray(evaluate_type(c.type, rows, c.params, 1 << k), dtype=bool)
-        R = np.array(rows, dtype=bool).T.reshape(1 << k, k)  # row x input
-        i0 = np.array([can0[x] for x in c.inputs]).reshape(k, m)
-        i1 = np.array([can1[x] for x in c.inputs]).reshape(k, m)
-        # feasible[row, change]: every input can take the row's value
-        feas = np.all(np.where(R[:, :, None], i1[None], i0[None]), axis=1)
-        o1 = np.any(feas & out[:, None], axis=0)
-        o0 = np.any(feas & ~out[:, None], axis=0)
-        for net in c.outputs:
-            can0[net], can1[net] = o0, o1
-    return {o: ~(can0[net] & can1[net]) for o, net in nl.outputs.items()}
+        vals[nm] = (~a | ~b, a | b)
+    t = evaluate3(nl, vals)
+    return {o: ~(t[net][0] & t[net][1]) for o, net in nl.outputs.items()}
 
 
 def _in_grid(tab: CellTable, move_time: float, load: float) -> bool:
