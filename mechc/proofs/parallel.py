@@ -71,7 +71,7 @@ def run_cases(fn: CaseFn, shared: Any, cases: Sequence[Any], lib: Library, jobs:
               weights: Sequence[int] | None = None) -> list[Any]:
     """``[fn(shared, lib, c) for c in cases]``, on ``jobs`` processes, or on the Dask cluster
     at ``scheduler``; ``progress`` hears of every finished case (``weights``: how much each
-    counts, 1 by default)."""
+    counts, 1 by default; the heaviest cases start first)."""
     w = list(weights) if weights is not None else [1] * len(cases)
     total = sum(w)
     if scheduler is None and (jobs <= 1 or len(cases) <= 1):
@@ -87,6 +87,13 @@ def run_cases(fn: CaseFn, shared: Any, cases: Sequence[Any], lib: Library, jobs:
         blob = pickle.dumps(work, protocol=pickle.HIGHEST_PROTOCOL)
         return _on_cluster(scheduler, blob, list(cases), w, progress)
     return _on_pool(min(jobs, len(cases)), work, list(cases), w, progress)
+
+
+def longest_first(weights: Sequence[int]) -> list[int]:
+    """Case indices, the heaviest first (ties in case order): started in this order, the
+    long cases do not end up alone at the end while the other workers idle (the longest-
+    processing-time rule)."""
+    return sorted(range(len(weights)), key=lambda i: (-weights[i], i))
 
 
 # ---- a process pool ---------------------------------------------------------------------------
@@ -126,7 +133,7 @@ def _on_pool(jobs: int, work: Work, cases: list, weights: list[int],
         work, protocol=pickle.HIGHEST_PROTOCOL)
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx,
                              initializer=_start_worker, initargs=(arg,)) as pool:
-        pending = {pool.submit(_pool_case, c): i for i, c in enumerate(cases)}
+        pending = {pool.submit(_pool_case, cases[i]): i for i in longest_first(weights)}
         try:
             while pending:
                 finished, _ = wait(pending, return_when=FIRST_COMPLETED)
@@ -184,8 +191,9 @@ def _gather(client, as_completed, blob: bytes, cases: list, weights: list[int],
     order."""
     key = hashlib.sha256(blob).hexdigest()
     [shared] = client.scatter([blob], broadcast=True)
-    futures = [client.submit(_cluster_case, shared, key, c, pure=False) for c in cases]
-    index = {f.key: i for i, f in enumerate(futures)}
+    order = longest_first(weights)
+    futures = [client.submit(_cluster_case, shared, key, cases[i], pure=False) for i in order]
+    index = {f.key: i for i, f in zip(order, futures)}
     out: list[Any] = [None] * len(cases)
     total, done = sum(weights), 0
     for f in as_completed(futures):
