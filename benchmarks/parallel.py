@@ -6,13 +6,14 @@ the same case by case.
 
 Designs: the full adder and the sorter (examples), a compiled random spec of about 80 cells
 (``mechc.bench.circuits.random_compiled(100, seed=100)``, as the speed benchmark's
-``random100``), and the speed controller ``examples/speedctl.fsm`` (sequential: its walks are
-the cases). Wall seconds (a parallel run is about wall time), the best of ``--repeat`` runs
-of each, the two settings interleaved so a change in the machine's load hits both; the load
-average is printed with the figures because the machine may be shared. "CPU ratio" is the CPU
-seconds of every process of the parallel run (workers included) over the serial run's: the
-work the pool adds (near 1: the speed-up is bounded by the free cores, not by overhead). Writes
-``parallel.csv`` and ``parallel.png`` to ``--out`` (default: docs/perf).
+``random100``), and the speed controller ``examples/speedctl.fsm`` (sequential: its walks cut
+into pieces from power-up, ``mechc.proofs.seq_logic.split_walks``, are what the processes
+share; "units" in the CSV). Wall seconds (a parallel run is about wall time), the best of
+``--repeat`` runs of each, the two settings interleaved so a change in the machine's load hits
+both; the load average is printed with the figures because the machine may be shared. "CPU
+ratio" is the CPU seconds of every process of the parallel run (workers included) over the
+serial run's: the work the pool adds (near 1: the speed-up is bounded by the free cores, not
+by overhead). Writes ``parallel.csv`` and ``parallel.png`` to ``--out`` (default: docs/perf).
 """
 
 from __future__ import annotations
@@ -124,7 +125,8 @@ def main() -> None:
         same = rec1 == recn and timeless(r1) == timeless(rn)
         ratio = best[1] / best[a.jobs]
         rows.append({"design": name, "cells": len(design.netlist.cells), "cases": r1.cases,
-                     "passed": r1.passed, "seconds_jobs_1": round(best[1], 3),
+                     "units": r1.coverage.get("pieces", r1.cases), "passed": r1.passed,
+                     "seconds_jobs_1": round(best[1], 3),
                      f"seconds_jobs_{a.jobs}": round(best[a.jobs], 3),
                      "speedup": round(ratio, 3), "cpu_seconds_jobs_1": round(cpu[1], 3),
                      f"cpu_seconds_jobs_{a.jobs}": round(cpu[a.jobs], 3),
@@ -133,7 +135,8 @@ def main() -> None:
               f"{best[a.jobs]:10.2f} {ratio:7.2f}x {cpu[a.jobs] / cpu[1]:9.2f}  "
               f"{'yes' if same else 'NO'}", flush=True)
     c1, cn = control(a.jobs, a.repeat)
-    rows.append({"design": "control (CPU loop)", "cells": 0, "cases": 8, "passed": True,
+    rows.append({"design": "control (CPU loop)", "cells": 0, "cases": 8, "units": 8,
+                 "passed": True,
                  "seconds_jobs_1": round(c1, 3), f"seconds_jobs_{a.jobs}": round(cn, 3),
                  "speedup": round(c1 / cn, 3), "cpu_seconds_jobs_1": "",
                  f"cpu_seconds_jobs_{a.jobs}": "", "cpu_ratio": "", "same_report": True})
@@ -171,7 +174,9 @@ def chart(rows: list[dict], jobs: int, path: Path) -> None:
     for i, r in enumerate(rows):
         ax.annotate(f"{r['speedup']:.2f}x", (x[i] + 0.2, many[i]), ha="center",
                     va="bottom", fontsize=9)
-    ax.set_xticks(x, [f"{r['design']}\n{r['cases']} cases" for r in rows], fontsize=8)
+    ax.set_xticks(x, [f"{r['design']}\n{r['cases']} cases"
+                      + (f", {r['units']} pieces" if r["units"] != r["cases"] else "")
+                      for r in rows], fontsize=8)
     ax.set_ylabel("wall seconds (dynamic proof; control: a CPU loop)")
     ax.set_title(f"mechc simulate --jobs {jobs} against --jobs 1 (same reports)")
     ax.legend()
