@@ -140,3 +140,25 @@ def test_a_piece_from_power_up_is_the_whole_walks_case(speedctl):
     assert cut[:first.end] == whole[:first.end]
     walked = {(r["sequence"], r["step"]): r for r in cut if "prefix" not in r}
     assert sorted(walked) == sorted((r["sequence"], r["step"]) for r in whole)
+
+
+def _spin(n: int, lib, case: int) -> int:
+    """CPU work proportional to ``case`` (a pool case must be a module-level function)."""
+    s = 0
+    for i in range(n * case):
+        s += i
+    return s
+
+
+def test_pool_cpu_counts_each_workers_cpu_seconds_for_the_critical_path():
+    """Two processes, cases of 1..6 units: the results are the serial ones, at most two
+    workers are counted, and neither did all the work (the longest case first keeps the
+    busiest worker near half of it)."""
+    from mechc.proofs import parallel
+
+    cases = [1, 2, 3, 4, 5, 6]
+    out = parallel.run_cases(_spin, 200_000, cases, LIB, jobs=2, weights=cases)
+    assert out == [sum(range(200_000 * c)) for c in cases]
+    busy = parallel.pool_cpu
+    assert 1 <= len(busy) <= 2 and all(v > 0 for v in busy.values())
+    assert max(busy.values()) < 0.9 * sum(busy.values())

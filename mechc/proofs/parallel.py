@@ -16,6 +16,7 @@ import hashlib
 import multiprocessing
 import os
 import pickle
+import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -98,6 +99,10 @@ def longest_first(weights: Sequence[int]) -> list[int]:
 
 # ---- a process pool ---------------------------------------------------------------------------
 _WORKER: tuple[CaseFn, Any, Library] | None = None
+#: CPU seconds each worker process (by id) spent in the cases of the last pool run: how evenly
+#: the cases fell, a figure the machine's load does not move as it moves wall time (read by
+#: benchmarks/parallel.py).
+pool_cpu: dict[int, float] = {}
 
 
 def _start_worker(work: Work | bytes) -> None:
@@ -109,9 +114,12 @@ def _start_worker(work: Work | bytes) -> None:
     _WORKER = (work.fn, work.shared, work.library())
 
 
-def _pool_case(case: Any) -> Any:
+def _pool_case(case: Any) -> tuple[int, float, Any]:
+    """The case's result, with the worker's process id and the CPU seconds it took."""
     fn, shared, lib = _WORKER
-    return fn(shared, lib, case)
+    t0 = time.process_time()
+    out = fn(shared, lib, case)
+    return os.getpid(), time.process_time() - t0, out
 
 
 def _pool_context():
@@ -125,6 +133,8 @@ def _on_pool(jobs: int, work: Work, cases: list, weights: list[int],
              progress: OnProgress | None, context=None) -> list[Any]:
     out: list[Any] = [None] * len(cases)
     total, done = sum(weights), 0
+    busy = pool_cpu
+    busy.clear()
     ctx = context or _pool_context()
     # a forked worker is handed the parent's objects without pickling (the design of an
     # 81-cell circuit takes 0.07 s to pickle and 0.12 s to unpickle in every worker);
@@ -139,7 +149,8 @@ def _on_pool(jobs: int, work: Work, cases: list, weights: list[int],
                 finished, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for f in finished:
                     i = pending.pop(f)
-                    out[i] = f.result()
+                    pid, cpu, out[i] = f.result()
+                    busy[pid] = busy.get(pid, 0.0) + cpu
                     done += weights[i]
                     if progress:
                         progress(done, total)
