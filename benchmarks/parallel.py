@@ -192,8 +192,8 @@ def chart(rows: list[dict], jobs: int, path: Path) -> None:
     ax.bar(x - 0.2, one, 0.4, label="--jobs 1")
     ax.bar(x + 0.2, many, 0.4, label=f"--jobs {jobs}")
     for i, r in enumerate(rows):
-        path = r.get("critical_path_speedup")
-        ax.annotate(f"{r['speedup']:.2f}x" + (f"\nCPU path {path:.2f}x" if path else ""),
+        cp = r.get("critical_path_speedup")
+        ax.annotate(f"{r['speedup']:.2f}x" + (f"\nCPU path {cp:.2f}x" if cp else ""),
                     (x[i] + 0.2, many[i]), ha="center", va="bottom", fontsize=8)
     ax.set_xticks(x, [f"{r['design']}\n{r['cases']} cases"
                       + (f", {r['units']} pieces" if r["units"] != r["cases"] else "")
