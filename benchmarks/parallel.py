@@ -8,9 +8,10 @@ Designs: the full adder and the sorter (examples), a compiled random spec of abo
 (``mechc.bench.circuits.random_compiled(100, seed=100)``, as the speed benchmark's
 ``random100``), and the speed controller ``examples/speedctl.fsm`` (sequential: its walks cut
 into pieces from power-up, ``mechc.proofs.seq_logic.split_walks``, are what the processes
-share; "units" in the CSV). Wall seconds (a parallel run is about wall time), the best of
-``--repeat`` runs of each, the two settings interleaved so a change in the machine's load hits
-both; the load average is printed with the figures because the machine may be shared. "CPU
+share; "units" in the CSV); without ``--quick`` also ``examples/sequence_detector.fsm``.
+Wall seconds (a parallel run is about wall time), the best of ``--repeat`` runs of each, the
+two settings interleaved so a change in the machine's load hits both; the load average is
+printed with the figures because the machine may be shared. "CPU
 ratio" is the CPU seconds of every process of the parallel run (workers included) over the
 serial run's: the work the pool adds (near 1: the speed-up is bounded by the free cores, not
 by overhead). "CPU path" is the speed-up the two runs' critical paths give in CPU seconds (this
@@ -53,6 +54,10 @@ def designs(quick: bool) -> list[tuple[str, object, dict]]:
     out.append((f"random{len(big.netlist.cells)}", big, {"max_cases": 8 if quick else 24}))
     out.append(("speedctl (sequential)", compile_spec(parse_fsm_file(EXAMPLES / "speedctl.fsm")),
                 {"sequential": True}))
+    if not quick:  # a second flow table, whose walks the cut was not tuned on
+        out.append(("sequence_detector (seq.)",
+                    compile_spec(parse_fsm_file(EXAMPLES / "sequence_detector.fsm")),
+                    {"sequential": True}))
     return out
 
 
