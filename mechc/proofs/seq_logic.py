@@ -478,9 +478,10 @@ def split_walks(spec: SeqSpec, walks: list[list[dict[str, int]]],
                 max_steps: int | None = None) -> list[Piece]:
     """Cut ``walks`` (from power-up, as :func:`transition_tour` gives them) into pieces of at
     most ``max_steps`` changes each, prefix included (default: an eighth of all the walks'
-    changes, at least 4), so that independent processes share them evenly. A piece may start
-    at any stable state of its walk; cuts are chosen for the fewest prefix changes (a return
-    to the power-up state costs none), then the fewest pieces. The pieces in order, each
+    changes, at least 4; a piece whose way there alone is that long takes one change of its
+    walk), so that independent processes share them evenly. A piece may start at any stable
+    state of its walk; cuts are chosen for the fewest prefix changes (a return to the power-up
+    state costs none), then the fewest pieces. The pieces in order, each
     walk's in walk order; together they take every change of every walk exactly once."""
     g = stable_graph(spec)
     total = sum(len(w) - 1 for w in walks)
