@@ -16,6 +16,7 @@ import hashlib
 import multiprocessing
 import os
 import pickle
+import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -71,7 +72,7 @@ def run_cases(fn: CaseFn, shared: Any, cases: Sequence[Any], lib: Library, jobs:
               weights: Sequence[int] | None = None) -> list[Any]:
     """``[fn(shared, lib, c) for c in cases]``, on ``jobs`` processes, or on the Dask cluster
     at ``scheduler``; ``progress`` hears of every finished case (``weights``: how much each
-    counts, 1 by default)."""
+    counts, 1 by default; the heaviest cases start first)."""
     w = list(weights) if weights is not None else [1] * len(cases)
     total = sum(w)
     if scheduler is None and (jobs <= 1 or len(cases) <= 1):
@@ -89,8 +90,19 @@ def run_cases(fn: CaseFn, shared: Any, cases: Sequence[Any], lib: Library, jobs:
     return _on_pool(min(jobs, len(cases)), work, list(cases), w, progress)
 
 
+def longest_first(weights: Sequence[int]) -> list[int]:
+    """Case indices, the heaviest first (ties in case order): started in this order, the
+    long cases do not end up alone at the end while the other workers idle (the longest-
+    processing-time rule)."""
+    return sorted(range(len(weights)), key=lambda i: (-weights[i], i))
+
+
 # ---- a process pool ---------------------------------------------------------------------------
 _WORKER: tuple[CaseFn, Any, Library] | None = None
+#: CPU seconds each worker process (by id) spent in the cases of the last pool run: how evenly
+#: the cases fell, a figure the machine's load does not move as it moves wall time (read by
+#: benchmarks/parallel.py).
+pool_cpu: dict[int, float] = {}
 
 
 def _start_worker(work: Work | bytes) -> None:
@@ -102,9 +114,12 @@ def _start_worker(work: Work | bytes) -> None:
     _WORKER = (work.fn, work.shared, work.library())
 
 
-def _pool_case(case: Any) -> Any:
+def _pool_case(case: Any) -> tuple[int, float, Any]:
+    """The case's result, with the worker's process id and the CPU seconds it took."""
     fn, shared, lib = _WORKER
-    return fn(shared, lib, case)
+    t0 = time.process_time()
+    out = fn(shared, lib, case)
+    return os.getpid(), time.process_time() - t0, out
 
 
 def _pool_context():
@@ -118,6 +133,8 @@ def _on_pool(jobs: int, work: Work, cases: list, weights: list[int],
              progress: OnProgress | None, context=None) -> list[Any]:
     out: list[Any] = [None] * len(cases)
     total, done = sum(weights), 0
+    busy = pool_cpu
+    busy.clear()
     ctx = context or _pool_context()
     # a forked worker is handed the parent's objects without pickling (the design of an
     # 81-cell circuit takes 0.07 s to pickle and 0.12 s to unpickle in every worker);
@@ -126,13 +143,14 @@ def _on_pool(jobs: int, work: Work, cases: list, weights: list[int],
         work, protocol=pickle.HIGHEST_PROTOCOL)
     with ProcessPoolExecutor(max_workers=jobs, mp_context=ctx,
                              initializer=_start_worker, initargs=(arg,)) as pool:
-        pending = {pool.submit(_pool_case, c): i for i, c in enumerate(cases)}
+        pending = {pool.submit(_pool_case, cases[i]): i for i in longest_first(weights)}
         try:
             while pending:
                 finished, _ = wait(pending, return_when=FIRST_COMPLETED)
                 for f in finished:
                     i = pending.pop(f)
-                    out[i] = f.result()
+                    pid, cpu, out[i] = f.result()
+                    busy[pid] = busy.get(pid, 0.0) + cpu
                     done += weights[i]
                     if progress:
                         progress(done, total)
@@ -184,8 +202,9 @@ def _gather(client, as_completed, blob: bytes, cases: list, weights: list[int],
     order."""
     key = hashlib.sha256(blob).hexdigest()
     [shared] = client.scatter([blob], broadcast=True)
-    futures = [client.submit(_cluster_case, shared, key, c, pure=False) for c in cases]
-    index = {f.key: i for i, f in enumerate(futures)}
+    order = longest_first(weights)
+    futures = [client.submit(_cluster_case, shared, key, cases[i], pure=False) for i in order]
+    index = {f.key: i for i, f in zip(order, futures)}
     out: list[Any] = [None] * len(cases)
     total, done = sum(weights), 0
     for f in as_completed(futures):

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import time
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -458,6 +459,70 @@ def transition_tour(spec: SeqSpec, seed: int = 0, random_walks: int = 0,
     n = spec.n
     return [[{name: (x >> (n - 1 - k)) & 1 for k, name in enumerate(spec.inputs)} for x in s]
             for s in seqs]
+
+
+@dataclass(frozen=True)
+class Piece:
+    """Steps ``start + 1 .. end`` of walk ``walk``, run from power-up: ``sequence`` is first the
+    shortest specified way from power-up to the walk's stable state at ``start`` (``prefix``
+    changes, none where that is the power-up state), then the walk's own input vectors."""
+
+    walk: int
+    start: int
+    end: int
+    prefix: int
+    sequence: list[dict[str, int]]
+
+
+def split_walks(spec: SeqSpec, walks: list[list[dict[str, int]]],
+                max_steps: int | None = None) -> list[Piece]:
+    """Cut ``walks`` (from power-up, as :func:`transition_tour` gives them) into pieces of at
+    most ``max_steps`` changes each, prefix included (default: an eighth of all the walks'
+    changes, at least 4; a piece whose way there alone is that long takes one change of its
+    walk), so that independent processes share them evenly. A piece may start at any stable
+    state of its walk; cuts are chosen for the fewest prefix changes (a return to the power-up
+    state costs none), then the fewest pieces. The pieces in order, each
+    walk's in walk order; together they take every change of every walk exactly once."""
+    g = stable_graph(spec)
+    total = sum(len(w) - 1 for w in walks)
+    cap = max_steps if max_steps is not None else max(4, -(-total // 8))
+    n = spec.n
+
+    def vec(d: dict[str, int]) -> int:
+        return sum((int(d[name]) & 1) << (n - 1 - k) for k, name in enumerate(spec.inputs))
+
+    def vectors(xs: list[int]) -> list[dict[str, int]]:
+        return [{name: (x >> (n - 1 - k)) & 1 for k, name in enumerate(spec.inputs)}
+                for x in xs]
+
+    ways: dict = {g.initial: []}  # stable state -> input columns of the way from power-up
+    pieces: list[Piece] = []
+    for wi, walk in enumerate(walks):
+        nodes = [(x, s) for x, s in _stable_walk(spec, walk)]
+        for node in nodes:
+            if node not in ways:
+                ways[node] = [x2 for x2, _ in path_to(g, g.initial, {node})]
+        m = len(walk) - 1
+        # best[b]: (prefix changes, pieces) to cover the walk's changes 1..b; cut[b]: the start
+        best: list[tuple[int, int]] = [(0, 0)] + [(0, 0)] * m
+        cut = [0] * (m + 1)
+        for b in range(1, m + 1):
+            options = [(best[a][0] + len(ways[nodes[a]]), best[a][1] + 1, -a)
+                       for a in range(b) if b - a + len(ways[nodes[a]]) <= cap or a == b - 1]
+            c, k, a = min(options)
+            best[b], cut[b] = (c, k), -a
+        bounds = []
+        b = m
+        while b > 0:
+            bounds.append((cut[b], b))
+            b = cut[b]
+        if not bounds:  # a walk with no change: the power-up state alone
+            bounds = [(0, 0)]
+        for a, b in reversed(bounds):
+            way = ways[nodes[a]]
+            seq = vectors([g.initial[0], *way]) + [dict(v) for v in walk[a + 1:b + 1]]
+            pieces.append(Piece(wi, a, b, len(way), seq))
+    return pieces
 
 
 def path_to(g, cur, targets):

@@ -30,7 +30,13 @@ from mechc.physics.scene import DynSettings, MoveResult, Scene
 from mechc.proofs.parallel import run_cases
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
-from mechc.proofs.seq_logic import expected_after, expected_states, transition_tour
+from mechc.proofs.seq_logic import (
+    Piece,
+    expected_after,
+    expected_states,
+    split_walks,
+    transition_tour,
+)
 from mechc.proofs.settings import ProofSettings, dyn_settings
 from mechc.proofs.trace import TraceRecorder
 
@@ -273,38 +279,53 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
                              sequences: list[list[dict[str, int]]] | None = None,
                              trace: TraceRecorder | None = None, jobs: int = 1,
                              scheduler: str | None = None,
-                             record: list | None = None) -> ProofReport:
+                             record: list | None = None,
+                             piece_steps: int | None = None) -> ProofReport:
     """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
-    each from the power-up inputs); a fresh scene per sequence starts at power-up, so the
-    sequences are independent cases: ``jobs`` processes or the Dask cluster at ``scheduler``
-    run them (``mechc.proofs.parallel``), merged in the serial order. ``record`` (a list)
-    receives each step's figures. Without
-    ``settings``, the defaults with the circuit's settle allowance (``dyn_settings``).
-    ``trace`` receives every body's pose at power-up and along every step."""
+    each from the power-up inputs, run whole). A fresh scene starts at power-up for every
+    case, so the cases are independent: ``jobs`` processes or the Dask cluster at
+    ``scheduler`` run them (``mechc.proofs.parallel``), merged in the serial order. The
+    generated walks are cut into pieces (``split_walks``, at most ``piece_steps`` changes
+    each) so that processes share them evenly: a piece starts from power-up and first takes
+    the shortest way to its start state (those prefix changes are judged too, labelled
+    ``prefix``); the cut depends on the spec only, never on ``jobs``, so every run gives the
+    same report. ``record`` (a list) receives each step's figures. Without ``settings``, the
+    defaults with the circuit's settle allowance (``dyn_settings``). ``trace`` receives every
+    body's pose at power-up and along every step (the walks then run whole, in this
+    process)."""
     t0 = time.perf_counter()
     mech = design.mechanism
     st = settings or dyn_settings(design, lib)
-    walks = (_walks(spec, seed, random_walks) if sequences is None
-             else [(s, expected_after(spec, s)) for s in sequences])
+    walks = (transition_tour(spec, seed=seed, random_walks=random_walks) if sequences is None
+             else sequences)
+    if sequences is None and trace is None:
+        pieces = split_walks(spec, walks, piece_steps)
+    else:
+        pieces = [Piece(wi, 0, len(w) - 1, 0, w) for wi, w in enumerate(walks)]
     fails = _Failures()
     _synthesis_failures(fails, design)
     dev = [0.0]
     max_vio = max_pen = max_err = max_settle = 0.0
     worst = ""
-    done = 0
+    done = prefix_steps = 0
     job = WalkJob(design, _types(design), st, trace)
-    cases = [(si, seq, want, expected_states(spec, seq) if trace is not None else [])
-             for si, (seq, want) in enumerate(walks)]
+    wants = [expected_after(spec, p.sequence) for p in pieces]
+    cases = [(p.walk, p.sequence, want,
+              expected_states(spec, p.sequence) if trace is not None else [])
+             for p, want in zip(pieces, wants)]
     if trace is not None:  # the recorder lives in this process: the walks run here
         jobs, scheduler = 1, None
     results = run_cases(run_walk, job, cases, lib, jobs, scheduler, progress,
-                        [len(seq) - 1 for seq, _ in walks])
-    for si, ((seq, want), steps) in enumerate(zip(walks, results)):
+                        [len(p.sequence) - 1 for p in pieces])
+    for p, want, steps in zip(pieces, wants, results):
+        seq = p.sequence
         cur = {k: float(v) for k, v in seq[0].items()}
         for k, (r, binding) in enumerate(steps, start=1):
             moved = next(n for n in seq[k] if seq[k][n] != cur[n])
-            where = {"sequence": si, "step": k, "moving": moved, "to": int(seq[k][moved]),
-                     "inputs": {n: int(v) for n, v in seq[k].items()}}
+            where = {"sequence": p.walk, "step": p.start + k - p.prefix, "moving": moved,
+                     "to": int(seq[k][moved]), "inputs": {n: int(v) for n, v in seq[k].items()}}
+            if k <= p.prefix:  # on the way to the piece's start state
+                where = {**where, "step": p.start, "prefix": k}
             if record is not None:
                 record.append({**where, "final": dict(r.final),
                                "max_violation_mm": r.max_violation,
@@ -336,10 +357,14 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
             _judge_outputs(fails, where, r.final, r.outputs, want[k - 1], want[k], tolerance,
                            dev)
             cur[moved] = float(seq[k][moved])
-            done += 1
+            if k <= p.prefix:
+                prefix_steps += 1
+            else:
+                done += 1
     return ProofReport(
         level="dynamic", kind="sequential", passed=fails.total == 0, cases=done,
-        coverage={"sequences": len(walks), "seed": seed, "tolerance_fraction": tolerance},
+        coverage={"sequences": len(walks), "pieces": len(pieces), "prefix_steps": prefix_steps,
+                  "seed": seed, "tolerance_fraction": tolerance},
         failure_count=fails.total, failure_kinds=fails.counts, failures=fails.items,
         figures={"max_position_error_fraction": round(max_err, 6),
                  "max_deviation_fraction": round(dev[0], 6),
