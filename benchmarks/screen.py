@@ -10,11 +10,11 @@ seeds 9100..; compiled by mechc as ``mechc.bench.circuits.random_compiled`` comp
 each: both proofs' seconds and verdicts, the ratio, how many changes the screen ran in pymunk,
 and, from the dynamic proof's own record of every change, whether any change the screen cleared
 failed there (the soundness check) and how the worst joint stretch and contact overrun over all
-changes compare with the worst over the changes the screen chose to run before any fallback
-(the basis of
-``mechc.proofs.screen.SOLVER_FACTOR``). Writes ``screen.csv`` and ``screen.png`` (seconds of
-both proofs per circuit) to ``--out`` (default docs/perf); ``--chart-from CSV`` redraws the
-chart of an earlier run.
+changes compare with the worst over the changes the screen chose to run before any fallback:
+their ratio and their gap as a share of the limit (the basis of
+``mechc.proofs.screen.JOINT_HEADROOM`` and ``CONTACT_HEADROOM``). Writes ``screen.csv`` and
+``screen.png`` (seconds of both proofs per circuit) to ``--out`` (default docs/perf);
+``--chart-from CSV`` redraws the chart of an earlier run.
 """
 
 from __future__ import annotations
@@ -133,7 +133,15 @@ def main() -> None:
                "worst_stretch_mm": round(worst["max_violation_mm"], 5),
                "stretch_all_over_ran": round(rho["max_violation_mm"], 3),
                "worst_overrun_mm": round(worst["max_penetration_mm"], 5),
-               "overrun_all_over_ran": round(rho["max_penetration_mm"], 3)}
+               "overrun_all_over_ran": round(rho["max_penetration_mm"], 3),
+               # what the plan's worst change reached beyond the worst the screen ran, as a
+               # share of the limit (the basis of JOINT_HEADROOM and CONTACT_HEADROOM)
+               "stretch_gap_of_limit": round((worst["max_violation_mm"]
+                                              - worst_ran["max_violation_mm"])
+                                             / st.violation_limit, 4),
+               "overrun_gap_of_limit": round((worst["max_penetration_mm"]
+                                              - worst_ran["max_penetration_mm"])
+                                             / st.penetration_limit, 4)}
         rows.append(row)
         print(row, flush=True)
     if not rows:
