@@ -10,11 +10,11 @@ seeds 9100..; compiled by mechc as ``mechc.bench.circuits.random_compiled`` comp
 each: both proofs' seconds and verdicts, the ratio, how many changes the screen ran in pymunk,
 and, from the dynamic proof's own record of every change, whether any change the screen cleared
 failed there (the soundness check) and how the worst joint stretch and contact overrun over all
-changes compare with the worst over the changes the screen chose to run before any fallback
-(the basis of
-``mechc.proofs.screen.SOLVER_FACTOR``). Writes ``screen.csv`` and ``screen.png`` (seconds of
-both proofs per circuit) to ``--out`` (default docs/perf); ``--chart-from CSV`` redraws the
-chart of an earlier run.
+changes compare with the worst over the changes the screen chose to run before any fallback:
+their ratio and their gap as a share of the limit (the basis of
+``mechc.proofs.screen.JOINT_HEADROOM`` and ``CONTACT_HEADROOM``). Writes ``screen.csv`` and
+``screen.png`` (seconds of both proofs per circuit) to ``--out`` (default docs/perf);
+``--chart-from CSV`` redraws the chart of an earlier run.
 """
 
 from __future__ import annotations
@@ -39,8 +39,9 @@ from mechc.ir.spec import OutputSpec, Spec  # noqa: E402
 from mechc.logic.cubes import Cube  # noqa: E402
 from mechc.pipeline import compile_spec  # noqa: E402
 from mechc.proofs.dynamic import prove_dynamic  # noqa: E402
-from mechc.proofs.screen import prove_screened  # noqa: E402
+from mechc.proofs.screen import _kind, decide, prove_screened  # noqa: E402
 from mechc.proofs.settings import ProofSettings, dyn_settings  # noqa: E402
+from mechc.proofs.timing import cell_tables  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -78,6 +79,36 @@ def failed_changes(rec: list[dict], report, st) -> set[int]:
                 or not math.isfinite(r["settle_time_s"])):
             bad.add(i)
     return bad
+
+
+def worst_witness_gaps(design, rec: list[dict], st, settings) -> dict[str, float]:
+    """Over the changes the screen may clear (no reason to run but being a witness): how far
+    each one's joint stretch, contact overrun and held-output excess over its closed form went
+    beyond the *mildest* change switching any of its (cell kind, direction) alike, as a share
+    of the limit (of the tolerance for the excess): every witness the worst choice (the basis
+    of ``JOINT_HEADROOM``, ``CONTACT_HEADROOM`` and ``HELD_MARGIN_SHARE``)."""
+    pairs, timed, dec = decide(design, design.spec, LIB, settings, st)
+    tables, _ = cell_tables(design, LIB, None, list(design.spec.inputs), pairs)
+    kind = {c.id: _kind(c, tables.get(c.id)) for c in design.netlist.cells.values()}
+    ks = [{(kind[c], d) for c, d in t["switched"].items()} for t in timed]
+    free = [i for i, d in enumerate(dec) if all(w.startswith("witness") for w in d["why"])]
+    excess = [max([dev - timed[i]["closed_form_swing"].get(o, 0.0)
+                   for o, dev in r["held_deviation"].items()] or [0.0])
+              for i, r in enumerate(rec)]
+    vals = {"stretch": ([r["max_violation_mm"] for r in rec], st.violation_limit),
+            "overrun": ([r["max_penetration_mm"] for r in rec], st.penetration_limit),
+            "held_excess": (excess, settings.tolerance)}
+    out = {}
+    for name, (v, lim) in vals.items():
+        mild: dict = {}
+        for i, k in enumerate(ks):
+            for key in k:
+                mild[key] = min(mild.get(key, math.inf), v[i])
+        out[f"worst_witness_{name}_gap"] = round(max(
+            ((v[i] - max(mild[key] for key in ks[i])) / lim for i in free if ks[i]),
+            default=0.0), 4)
+    out["held_excess_of_tolerance"] = round(max(excess, default=0.0) / settings.tolerance, 4)
+    return out
 
 
 def main() -> None:
@@ -133,7 +164,16 @@ def main() -> None:
                "worst_stretch_mm": round(worst["max_violation_mm"], 5),
                "stretch_all_over_ran": round(rho["max_violation_mm"], 3),
                "worst_overrun_mm": round(worst["max_penetration_mm"], 5),
-               "overrun_all_over_ran": round(rho["max_penetration_mm"], 3)}
+               "overrun_all_over_ran": round(rho["max_penetration_mm"], 3),
+               # what the plan's worst change reached beyond the worst the screen ran, as a
+               # share of the limit (the basis of JOINT_HEADROOM and CONTACT_HEADROOM)
+               "stretch_gap_of_limit": round((worst["max_violation_mm"]
+                                              - worst_ran["max_violation_mm"])
+                                             / st.violation_limit, 4),
+               "overrun_gap_of_limit": round((worst["max_penetration_mm"]
+                                              - worst_ran["max_penetration_mm"])
+                                             / st.penetration_limit, 4),
+               **worst_witness_gaps(design, rec, st, settings)}
         rows.append(row)
         print(row, flush=True)
     if not rows:

@@ -34,11 +34,11 @@ levels:
              input vector at rest and sampled along every single-input change: outputs within
              --tolerance of their positions, outputs that must not change dwell; design checks
   screened   (default) the dynamic level's verdict, with pymunk run only on the changes the
-             timing level cannot vouch for (small slack, a switching amplifier or untimed
+             timing level cannot vouch for (small slack, an untimed or heavily loaded
              cell, a held output with a possible hazard or near its tolerance) and on
              witnesses of every cell kind the others switch; it falls back to every change
-             when the changes that ran disagree with the timing model or come within a
-             stated factor of a solver limit; a sequential design runs every transition
+             when the changes that ran disagree with the timing model or leave less than
+             a stated headroom of a solver limit; a sequential design runs every transition
   dynamic    the reference: pymunk rigid bodies, springs and contacts; inputs moved by
              bounded-force actuators along a Gray-code tour of every vector plus --cases
              seeded random changes; outputs at rest, glitches, settling, joint violations
