@@ -151,7 +151,8 @@ def reduce_problem(A: sparse.csr_matrix, cost: np.ndarray):
 def min_cover(masks: np.ndarray, values: np.ndarray, on_rows: np.ndarray, dc_rows: np.ndarray,
               n: int, time_limit: float, dc_time: float = 2.0) -> CoverResult:
     """Minimum (terms, literals) cover of ``on_rows`` by the candidate cubes; among minimum
-    covers, one switching on the fewest don't-care rows (a second, time-capped program)."""
+    covers, one switching on the fewest don't-care rows (a second, time-capped program).
+    ``time_limit`` <= 0: the greedy cover only (method ``greedy``)."""
     t0 = time.perf_counter()
     P = len(masks)
     if len(on_rows) == 0:
@@ -159,6 +160,8 @@ def min_cover(masks: np.ndarray, values: np.ndarray, on_rows: np.ndarray, dc_row
     A = coverage(masks, values, on_rows)
     lits = _lits(masks)
     g = greedy_cover(A, 1.0 + lits / (n + 1.0))
+    if time_limit <= 0:  # no time for a program (the caller's clock is out): greedy
+        return CoverResult(np.sort(g), False, "greedy", time.perf_counter() - t0)
     w_term = n * len(g) + 1  # more than any literal difference between covers of equal size
     c = (w_term + lits).astype(float)
     forced, rows, cols = reduce_problem(A, c)
