@@ -17,6 +17,7 @@ handler) the steps keep to their own limits only.
 
 from __future__ import annotations
 
+import contextvars
 import signal
 import threading
 import time
@@ -28,6 +29,22 @@ from contextlib import contextmanager
 SLOWDOWN_CAP = 2.5
 #: The slowdown is counted only after this many CPU seconds (1 before).
 SLOWDOWN_MIN_CPU = 0.3
+
+
+#: Work floors (local search's ``min_steps``, which make a result independent of the load)
+#: give way this many seconds before the hard end, so the step returns its best answer
+#: instead of being stopped with nothing.
+FLOOR_MARGIN = 0.5
+
+_END: contextvars.ContextVar[float | None] = contextvars.ContextVar("minimise_end",
+                                                                    default=None)
+
+
+def floors_hold() -> bool:
+    """Whether work floors still hold: False within ``FLOOR_MARGIN`` of the hard end of the
+    ``hard_stop`` around the caller (always True outside one)."""
+    end = _END.get()
+    return end is None or time.perf_counter() < end - FLOOR_MARGIN
 
 
 class WallClockOut(Exception):
@@ -96,9 +113,23 @@ def hard_stop(until: float | None) -> Iterator[bool]:
     (None: never). Yields whether the stop is armed (False off the main thread or when
     SIGALRM is in use already: the body then only has its own limits). A body that starts
     after ``until`` is stopped at once."""
-    if until is None or not _can_alarm():
+    if until is None:
         yield False
         return
+    token = _END.set(until)
+    try:
+        if not _can_alarm():
+            yield False
+            return
+        with _alarm(until):
+            yield True
+    finally:
+        _END.reset(token)
+
+
+@contextmanager
+def _alarm(until: float) -> Iterator[None]:
+    """SIGALRM raising ``WallClockOut`` in the body at ``until``."""
     state = {"armed": True}
 
     def ring(_signum, _frame) -> None:
@@ -109,7 +140,7 @@ def hard_stop(until: float | None) -> Iterator[bool]:
     old = signal.signal(signal.SIGALRM, ring)
     try:
         signal.setitimer(signal.ITIMER_REAL, max(1e-4, until - time.perf_counter()))
-        yield True
+        yield
     finally:
         state["armed"] = False
         signal.setitimer(signal.ITIMER_REAL, 0.0)
