@@ -229,3 +229,26 @@ def test_reduce_dense_past_its_deadline_keeps_the_same_problem():
     covered[np.flatnonzero(np.asarray(A[:, forced].sum(axis=1)).ravel() > 0)] = True
     assert set(rows.tolist()) | set(np.flatnonzero(covered).tolist()) == set(range(A.shape[0]))
     assert len(cols) + len(forced) >= 1
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_quick_multi_cover_is_right_on_every_vector(seed):
+    """The cover kept in hand for a stopped multi-output step: each output's cubes switch
+    on every on-point and nothing outside on ∪ dc (references read from the PLA text), with
+    no more products than the PLA's rows it starts from."""
+    from mechc.logic.quick_multi import quick_multi_cover
+    rng = np.random.default_rng(1300 + seed)
+    n, m = int(rng.integers(5, 10)), int(rng.integers(2, 15))
+    text = random_pla.random_pla(rng, n, m, int(rng.integers(10, 120)))
+    spec = parse_pla(text)
+    _, on, dc = pla_sets(text)
+    rows_cover = [spec.functions[o].on for o in spec.outputs]
+    got = quick_multi_cover(n, on, on | dc, [rows_cover])
+    pts = np.arange(1 << n, dtype=np.int64)
+    for i in range(m):
+        val = eval_cover(got[i], pts)
+        assert not (on[i] & ~val).any() and not (val & ~(on[i] | dc[i])).any()
+    distinct = {c for cubes in got for c in cubes}
+    assert len(distinct) <= len({c for cubes in rows_cover for c in cubes})
+    if n <= 4:
+        assert len(distinct) >= brute_min_products(n, on, dc)

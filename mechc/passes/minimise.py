@@ -28,6 +28,7 @@ from mechc.logic.hazards import hazard_free
 from mechc.logic.implicants import own_primes, region_sets, table_fits, ternary_table
 from mechc.logic.multi import minimise_multi
 from mechc.logic.primes import TooManyPrimes, prime_implicants
+from mechc.logic.quick_multi import quick_multi_cover
 
 
 @dataclass
@@ -100,6 +101,11 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
         # under load the mapper's alternatives below are cut, not it
         per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
                                eq.xor_forms)
+        # a multi-output cover to keep in hand should the step below be stopped (and one
+        # more start for it): the per-output covers' and the PLA's cubes raised to
+        # multi-output primes, then a greedy, irredundant cover of them
+        quick = _stopped(steps_end, limited, "quick multi-output cover", _quick_multi, spec,
+                         eq)
         # its preparation (the primes' table, the covering matrix, the reductions: 1.1 s of
         # CPU on alu4) has no time check, so under load its limit keeps well inside the
         # wall clock left; alu4's 575 products come at a limit of 0.5 s as at 4 s
@@ -107,11 +113,15 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
                  max(clock.floor(0.5, HAZARD_RESERVE), MULTI_SHARE * clock.left(HAZARD_RESERVE)),
                  max(0.2, MULTI_WALL_SHARE * clock.wall_left(HAZARD_RESERVE)))
         got = _stopped(steps_end, limited, "multi-output cover", _multi_output, spec, eq,
-                       replace(opts, time_limit=mt, multi_time_limit=mt))
+                       replace(opts, time_limit=mt, multi_time_limit=mt), quick)
         if got is not None:
             new, timed = got
             limited.extend(timed)
             eq.covers.update(new)
+        if quick is not None and _cover_cost(quick) < _cover_cost(
+                [eq.covers[o].cubes for o in spec.outputs]):
+            for o, cubes in zip(spec.outputs, quick):
+                eq.covers[o] = Cover(cubes, False, "quick multi-output", eq.covers[o].seconds)
         if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
             _stopped(steps_end, limited, "shared per-output covers", _share, spec, per_output,
                      prime_sets, replace(opts, time_limit=min(
@@ -290,8 +300,18 @@ MIN_STEP_SECONDS = 0.3
 HAZARD_RESERVE = 1.0
 
 
-def _multi_output(spec: Spec, eq: Equations,
-                  opts: MinimiseOptions) -> tuple[dict[str, Cover], list[str]]:
+def _quick_multi(spec: Spec, eq: Equations) -> list[list[Cube]] | None:
+    """``quick_multi.quick_multi_cover`` from the per-output covers and a PLA's own rows."""
+    tables = np.array([spec.table(o) for o in spec.outputs])
+    starts = [[eq.covers[o].cubes for o in spec.outputs]]
+    if spec.kind == "pla":
+        starts.append([spec.functions[o].on for o in spec.outputs])
+    return quick_multi_cover(spec.n, tables == 1, tables != 0, starts)
+
+
+def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions,
+                  quick: list[list[Cube]] | None = None
+                  ) -> tuple[dict[str, Cover], list[str]]:
     """The multi-output covers that replace the per-output ones when they have fewer
     distinct products (then literals plus OR inputs); every output's ``proven`` then says
     whether the multi-output minimum is proven. Returns (covers, the steps whose time limit
@@ -302,6 +322,8 @@ def _multi_output(spec: Spec, eq: Equations,
     start = [eq.covers[o].cubes for o in spec.outputs]
     dc = [spec.functions[o].dc for o in spec.outputs] if spec.kind == "pla" else None
     seeds = [[spec.functions[o].on for o in spec.outputs]] if spec.kind == "pla" else []
+    if quick is not None:
+        seeds.append(quick)
     res = minimise_multi(n, on, region, start, dc, min(opts.time_limit, opts.multi_time_limit),
                          opts.prime_limit, seeds=seeds)
     old = _cover_cost([eq.covers[o].cubes for o in spec.outputs])
@@ -323,9 +345,10 @@ def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
 
 
 #: Every output's primes come from one ternary table (``implicants.own_primes``) up to this
-#: many cubes (3**15: 14 million entries, a fraction of a second); beyond, per output by the
-#: Shannon recursion of ``primes.py``.
-OWN_TABLE_MAX_CUBES = 3 ** 15
+#: many cubes (3**16: 43 million entries, within the table's byte cap for up to 16 outputs);
+#: beyond, per output by the Shannon recursion of ``primes.py``. At 16 inputs the table
+#: halved the per-output covers' CPU on a random 11-output PLA (3.8 s against 7.3 s).
+OWN_TABLE_MAX_CUBES = 3 ** 16
 
 
 def _own_primes(regions: np.ndarray, n: int) -> list | None:
