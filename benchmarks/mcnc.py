@@ -185,7 +185,7 @@ def run(paths: list[Path]) -> list[dict]:
     return out
 
 
-def run_random(count: int, seed: int) -> list[dict]:
+def run_random(count: int, seed: int, opts: MinimiseOptions | None = None) -> list[dict]:
     """Minimise ``count`` random MCNC-shaped PLAs (seed ``seed``) and run espresso on each."""
     import tempfile
 
@@ -198,7 +198,7 @@ def run_random(count: int, seed: int) -> list[dict]:
             spec = parse_pla_file(path)
             t0, c0 = time.perf_counter(), time.process_time()
             try:
-                eq = minimise(spec)
+                eq = minimise(spec, opts)
             except MechcError as e:  # reported as a row, the run goes on
                 out.append({"name": name, "inputs": spec.n, "outputs": len(spec.outputs),
                             "error": str(e)})
@@ -276,6 +276,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--random", type=int, metavar="N",
                     help="N random MCNC-shaped PLAs instead of DIR (needs pyeda)")
     ap.add_argument("--seed", type=int, default=1, help="seed of --random")
+    ap.add_argument("--wall-limit", type=float, metavar="S",
+                    help="the minimiser's hard end in seconds (0: none; default: its own), "
+                    "to see what a PLA needs apart from the load")
     args = ap.parse_args(argv)
     if args.random:
         return main_random(args)
@@ -305,7 +308,10 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def main_random(args) -> int:
-    rows = run_random(args.random, args.seed)
+    opts = None
+    if args.wall_limit is not None:
+        opts = MinimiseOptions(wall_limit=args.wall_limit or None)
+    rows = run_random(args.random, args.seed, opts)
     done = [r for r in rows if "error" not in r]
     if any(r["source"] == "published" for r in done):
         print("--random needs pyeda (pip install -e '.[bench]')", file=sys.stderr)
