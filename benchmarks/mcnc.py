@@ -2,6 +2,7 @@
 
     python benchmarks/mcnc.py DIR [--max-inputs 16] [--markdown]
     python benchmarks/mcnc.py            # the small PLAs under tests/logic/pla (for CI)
+    python benchmarks/mcnc.py --random 40 --seed 1 [--markdown]   # held-out random PLAs
 
 For every .pla in DIR with at most ``--max-inputs`` inputs: mechc's distinct products (what
 espresso's ``.p`` counts) and minimisation seconds; espresso's product count from the original
@@ -13,7 +14,13 @@ every vector by the minimiser itself, and the mapped design of the default one i
 on every input vector against the spec (the run stops at a mismatch). ``--markdown``
 rewrites the table in docs/minimisation.md. The MCNC PLAs (the LGSynth'91 two-level suite)
 are not shipped with mechc.
-Exit status 1 if mechc has more products than espresso on any PLA.
+
+``--random N --seed S``: N random PLAs shaped like the MCNC ones (``random_pla.py``: 8-16
+inputs, 5-40 outputs, 20-500 rows, don't-care rows), which the minimiser was never tuned on:
+mechc's distinct products and seconds against espresso's (through pyeda, required here),
+without the mapping. ``--markdown`` then rewrites the random table in docs/minimisation.md.
+Exit status 1 if mechc has more products than espresso on any PLA, or (``--random``) takes
+over 10 s on any.
 """
 
 from __future__ import annotations
@@ -25,6 +32,7 @@ import time
 from pathlib import Path
 
 from mechc.cells.library import load_library
+from mechc.errors import MechcError
 from mechc.frontends.pla import parse_pla_file
 from mechc.passes.map import map_equations
 from mechc.passes.minimise import MinimiseOptions, minimise
@@ -36,6 +44,9 @@ DOC = ROOT / "docs" / "minimisation.md"
 #: the reference for "no more parts than before".
 BASELINE = Path(__file__).with_name("mcnc_baseline.json")
 BEGIN, END = "<!-- mcnc table begin -->", "<!-- mcnc table end -->"
+RBEGIN, REND = "<!-- random table begin -->", "<!-- random table end -->"
+#: The minimisation of one PLA must end within this many seconds (wall clock).
+MAX_SECONDS = 10.0
 #: espresso's product counts on the MCNC PLAs (multi-output heuristic cover), used only when
 #: pyeda is not installed.
 PUBLISHED = {"5xp1": 65, "9sym": 86, "Z5xp1": 76, "alu4": 575, "apex4": 435, "b12": 42,
@@ -86,6 +97,35 @@ def espresso_products(path: Path) -> tuple[int | None, float, str]:
     t0 = time.perf_counter()
     cover = espresso(n, m, rows, intype=intype)
     return len({inp for inp, _ in cover}), time.perf_counter() - t0, "pyeda"
+
+
+#: pyeda's espresso ran for over 10 minutes on some random PLAs (14 inputs, 34 outputs);
+#: the random set gives it this long in a child process, then counts it as timed out.
+ESPRESSO_TIMEOUT_S = 60.0
+
+
+def _espresso_child(path: str, conn) -> None:
+    conn.send(espresso_products(Path(path)))
+    conn.close()
+
+
+def espresso_products_timed(path: Path, timeout: float = ESPRESSO_TIMEOUT_S
+                            ) -> tuple[int | None, float, str]:
+    """``espresso_products`` in a forked child stopped after ``timeout`` seconds (espresso
+    is C code: it cannot be interrupted in this process). Source "timeout" when stopped."""
+    import multiprocessing
+    ctx = multiprocessing.get_context("fork")
+    recv, send = ctx.Pipe(duplex=False)
+    child = ctx.Process(target=_espresso_child, args=(str(path), send))
+    child.start()
+    send.close()
+    if recv.poll(timeout):
+        got = recv.recv()
+        child.join()
+        return got
+    child.kill()
+    child.join()
+    return None, timeout, "timeout"
 
 
 def mapped(eq, lib, spec=None) -> tuple[int, int]:
@@ -145,6 +185,55 @@ def run(paths: list[Path]) -> list[dict]:
     return out
 
 
+def run_random(count: int, seed: int, opts: MinimiseOptions | None = None) -> list[dict]:
+    """Minimise ``count`` random MCNC-shaped PLAs (seed ``seed``) and run espresso on each."""
+    import tempfile
+
+    from random_pla import random_set  # benchmarks/ is on the path when run as a script
+    out = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, text in random_set(count, seed):
+            path = Path(tmp) / f"{name}.pla"
+            path.write_text(text)
+            spec = parse_pla_file(path)
+            t0, c0 = time.perf_counter(), time.process_time()
+            try:
+                eq = minimise(spec, opts)
+            except MechcError as e:  # reported as a row, the run goes on
+                out.append({"name": name, "inputs": spec.n, "outputs": len(spec.outputs),
+                            "error": str(e)})
+                print(f"{name}: {e}", flush=True)
+                continue
+            seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
+            esp, esp_s, source = espresso_products_timed(path)
+            row = {"name": name, "inputs": spec.n, "outputs": len(spec.outputs),
+                   "rows": text.count("\n") - 5, "products": eq.products, "espresso": esp,
+                   "espresso_s": esp_s, "source": source, "seconds": seconds, "cpu": cpu,
+                   "proven": eq.proven, "time_limited": list(eq.time_limited)}
+            out.append(row)
+            print(f"{name:>22} products {eq.products:>4} (espresso {esp} in {esp_s:.2f} s) "
+                  f"{seconds:6.2f} s (cpu {cpu:.2f} s){' proven' if eq.proven else ''}"
+                  f"{' ' + '; '.join(eq.time_limited) if eq.time_limited else ''}", flush=True)
+    return out
+
+
+def markdown_random(rows: list[dict], count: int, seed: int) -> str:
+    lines = [f"`python benchmarks/mcnc.py --random {count} --seed {seed}`", "",
+             "| PLA | in | out | rows | mechc products | espresso products | mechc s "
+             "| mechc cpu s | espresso s | proven | time limits |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if "error" in r:
+            lines.append(f"| {r['name']} | {r['inputs']} | {r['outputs']} | error: "
+                         f"{r['error']} |||||||")
+            continue
+        lines.append(f"| {r['name']} | {r['inputs']} | {r['outputs']} | {r['rows']} | "
+                     f"{r['products']} | {r['espresso'] or 'out of time'} | "
+                     f"{r['seconds']:.1f} | {r['cpu']:.1f} | {r['espresso_s']:.2f} | "
+                     f"{'yes' if r['proven'] else 'no'} | {len(r['time_limited'])} |")
+    return "\n".join(lines)
+
+
 def markdown(rows: list[dict]) -> str:
     lines = ["| PLA | in | out | mechc products | espresso products | per-output products "
              "| mechc s | mechc cpu s | s before (cpu) | proven | parts per-output | parts now "
@@ -168,9 +257,9 @@ def markdown(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
-def write_doc(table: str) -> None:
+def write_doc(table: str, begin: str = BEGIN, end: str = END) -> None:
     text = DOC.read_text()
-    a, b = text.index(BEGIN) + len(BEGIN), text.index(END)
+    a, b = text.index(begin) + len(begin), text.index(end)
     DOC.write_text(text[:a] + "\n" + table + "\n" + text[b:])
 
 
@@ -184,7 +273,15 @@ def main(argv: list[str] | None = None) -> int:
                     "time limit ran out) to FILE")
     ap.add_argument("--markdown", action="store_true",
                     help="rewrite the table in docs/minimisation.md")
+    ap.add_argument("--random", type=int, metavar="N",
+                    help="N random MCNC-shaped PLAs instead of DIR (needs pyeda)")
+    ap.add_argument("--seed", type=int, default=1, help="seed of --random")
+    ap.add_argument("--wall-limit", type=float, metavar="S",
+                    help="the minimiser's hard end in seconds (0: none; default: its own), "
+                    "to see what a PLA needs apart from the load")
     args = ap.parse_args(argv)
+    if args.random:
+        return main_random(args)
     paths = sorted(Path(args.dir).glob("*.pla"))
     if args.only:
         paths = [p for p in paths if p.stem in args.only]
@@ -195,7 +292,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = run(paths)
     worse = [r["name"] for r in rows if r["espresso"] is not None
              and r["products"] > r["espresso"]]
-    slow = [r["name"] for r in rows if r["seconds"] > 10]
+    slow = [r["name"] for r in rows if r["seconds"] > MAX_SECONDS]
     more_parts = [r["name"] for r in rows if r["parts_after"] > r["parts_before"]]
     above = [r["name"] for r in rows if r["parts_baseline"] is not None
              and r["parts_after"] > r["parts_baseline"]]
@@ -208,6 +305,33 @@ def main(argv: list[str] | None = None) -> int:
         write_doc(markdown(rows))
         print(f"wrote the table in {DOC.relative_to(ROOT)}")
     return 1 if worse else 0
+
+
+def main_random(args) -> int:
+    opts = None
+    if args.wall_limit is not None:
+        opts = MinimiseOptions(wall_limit=args.wall_limit or None)
+    rows = run_random(args.random, args.seed, opts)
+    done = [r for r in rows if "error" not in r]
+    if any(r["source"] == "published" for r in done):
+        print("--random needs pyeda (pip install -e '.[bench]')", file=sys.stderr)
+        return 2
+    worse = [r["name"] for r in done if r["espresso"] is not None
+             and r["products"] > r["espresso"]]
+    timeouts = [r["name"] for r in done if r["espresso"] is None]
+    slow = [r["name"] for r in done if r["seconds"] > MAX_SECONDS]
+    failed = [r["name"] for r in rows if "error" in r]
+    fewer = sum(r["espresso"] is not None and r["products"] < r["espresso"] for r in done)
+    print(f"{len(done)} PLAs: fewer products than espresso on {fewer}, more on "
+          f"{worse or 'none'}; over {MAX_SECONDS:g} s: {slow or 'none'} (slowest "
+          f"{max((r['seconds'] for r in done), default=0):.1f} s); errors: {failed or 'none'}"
+          f"; espresso out of time ({ESPRESSO_TIMEOUT_S:g} s): {timeouts or 'none'}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(rows, indent=1))
+    if args.markdown:
+        write_doc(markdown_random(rows, args.random, args.seed), RBEGIN, REND)
+        print(f"wrote the random table in {DOC.relative_to(ROOT)}")
+    return 1 if worse or slow or failed else 0
 
 
 if __name__ == "__main__":

@@ -182,7 +182,7 @@ def test_wide_complement_is_cubes_not_minterms():
 
     n = 15
     spec = parse_pla(f".i {n}\n.o 1\n1-------1------ 1\n.e\n", "wide.pla")
-    eq = minimise(spec)
+    eq = minimise(spec, MinimiseOptions(wall_limit=None))  # complements kept under load
     pts = np.arange(1 << n, dtype=np.int64)
     want = ~(((pts >> (n - 1)) & 1).astype(bool) & ((pts >> (n - 9)) & 1).astype(bool))
     for cover in (eq.complements["f0"], eq.hazard_free_complements["f0"]):
@@ -227,7 +227,8 @@ def test_covers_from_the_shared_table_are_correct_and_hazard_free(seed):
     rng = np.random.default_rng(4400 + seed)
     n = 9
     tables = {f"f{i}": random_table(rng, n, p_on=0.45, p_dc=0.15) for i in range(3)}
-    eq = minimise(spec_from_tables(tables, n))
+    # no hard end: under load it may leave complements out, and this is about correctness
+    eq = minimise(spec_from_tables(tables, n), MinimiseOptions(wall_limit=None))
     rows = np.arange(1 << n)
     for name, t in tables.items():
         care = t != DC

@@ -24,6 +24,8 @@ import time
 import numpy as np
 from scipy import sparse
 
+from mechc.logic.clock import floors_hold
+
 
 def _gather(indptr: np.ndarray, indices: np.ndarray, which: np.ndarray) -> np.ndarray:
     """The concatenated index lists of the rows (or columns) ``which``."""
@@ -111,7 +113,8 @@ def heuristic_cover(A: sparse.csr_matrix, cost: np.ndarray, time_limit: float,
     ``cost``): greedy (or ``start``, column indices of a cover), redundancy removal, then row
     weighting local search until ``time_limit`` (or ``max_steps`` steps), but at least
     ``min_steps`` steps when the time limit is positive (a result that does not depend on
-    how busy the machine is)."""
+    how busy the machine is; the floor gives way near the minimisation's hard end,
+    ``clock.floors_hold``)."""
     t_end = time.perf_counter() + time_limit
     S = _Cover(A, cost)
     if S.nr == 0:
@@ -207,7 +210,7 @@ def _row_weighting(S: _Cover, chosen: np.ndarray, cov: np.ndarray, t_end: float,
         return int(top[np.argmin(stamp[top])])
 
     last = -1
-    while ((step < min_steps or time.perf_counter() < t_end)
+    while ((step < min_steps and floors_hold() or time.perf_counter() < t_end)
            and (max_steps is None or step < max_steps)):
         step += 1
         while n_open == 0:

@@ -20,6 +20,7 @@ import numpy as np
 from mechc.errors import MechcError, UsageError
 from mechc.ir.equations import Cover, Equations, XorForm
 from mechc.ir.spec import Spec
+from mechc.logic.clock import Clock, WallClockOut, hard_stop
 from mechc.logic.cover import min_cover, share_covers
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, eval_cover
 from mechc.logic.espresso import check_cover, espresso
@@ -27,6 +28,7 @@ from mechc.logic.hazards import hazard_free
 from mechc.logic.implicants import own_primes, region_sets, table_fits, ternary_table
 from mechc.logic.multi import minimise_multi
 from mechc.logic.primes import TooManyPrimes, prime_implicants
+from mechc.logic.quick_multi import quick_multi_cover
 
 
 @dataclass
@@ -44,6 +46,11 @@ class MinimiseOptions:
     # per-output covers share 45 % of what is left, the multi-output step and the sharing
     # program most of the rest (None: each step keeps its own limit only)
     budget: float | None = 7.0
+    # wall seconds after which no step of the minimisation of a truth-table spec runs on
+    # (``logic/clock.py``: a step still running is stopped and the best answer found before
+    # it kept; only the final check comes after): the whole call ends within 10 s even on a
+    # loaded machine (None: no hard end)
+    wall_limit: float | None = 8.5
 
 
 def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
@@ -53,84 +60,90 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     n = spec.n
     covers: dict[str, Cover] = {}
     comps: dict[str, Cover] = {}
-    prime_sets = {}
-    comp_sets = {}
+    prime_sets: dict = {}
+    comp_sets: dict = {}
     limited: list[str] = []
     multi = opts.multi_output and len(spec.outputs) > 1 and spec.kind != "fsm"
     m = len(spec.outputs)
-    clock = _Clock(opts.budget)
-    # the mapper's alternatives share one budget, so many outputs do not multiply it
-    aopts = replace(opts, alt_time_limit=min(opts.alt_time_limit, ALT_BUDGET / m))
+    clock = Clock(opts.budget, opts.wall_limit)
+    steps_end = clock.end(HAZARD_RESERVE)  # the consensus terms get the last second
     tables = np.array([spec.table(o) for o in spec.outputs])
     own = _own_primes(tables != 0, n)  # every output's primes at once (None: too wide)
-    comp_own = _own_primes(tables != 1, n) \
-        if opts.complements and n <= ALT_EXACT_MAX_INPUTS else None
     for i, name in enumerate(spec.outputs):
-        table = tables[i]
+        # under load these keep to a third of the wall clock left, so the multi-output step
+        # after them is not cut (ex1010's exact covers took 6 s of 8 at load 8)
         copts = replace(opts, time_limit=min(opts.time_limit, max(
-            MIN_STEP_SECONDS, COVER_SHARE * clock.left() / (m - i))))
-        covers[name], prime_sets[name] = _minimise_table(
-            table, n, copts, primes=own[i] if own is not None else None)
-        if not covers[name].proven and covers[name].method != "expand":
+            clock.floor(MIN_STEP_SECONDS, HAZARD_RESERVE),
+            COVER_SHARE * clock.left(HAZARD_RESERVE) / (m - i)),
+            max(0.05, COVER_WALL_SHARE * clock.wall_left(HAZARD_RESERVE) / (m - i))))
+        if opts.wall_limit and clock.elapsed() > COVER_WALL_END * opts.wall_limit:
+            copts = replace(copts, time_limit=0.0)  # the rest: greedy covers of their primes
+        got = None
+        try:
+            with hard_stop(steps_end):
+                got = _minimise_table(tables[i], n, copts,
+                                      primes=own[i] if own is not None else None)
+        except WallClockOut:
+            pass
+        if got is None:  # the wall clock ran out: a quick cover, not a minimum
+            got = _quick_cover(spec, name, tables[i], n), None
+            limited.append(f"cover of {name} (wall clock: a quick cover)")
+        covers[name], prime_sets[name] = got
+        if not covers[name].proven and covers[name].method not in ("expand", "quick"):
             limited.append(f"cover of {name}")
-        if opts.complements:
-            # the alternatives' limits are CPU work too: scaled by the load seen so far (under
-            # load 10 espresso's 3 s ran out on alu4's f7: 517 more parts)
-            comps[name], comp_sets[name] = _minimise_alt(
-                _complement(table), n, _scaled(aopts, clock),
-                comp_own[i] if comp_own is not None else None)
-            if comps[name].method == "greedy" or comps[name].method.endswith("(time limit)"):
-                limited.append(f"complement cover of {name} (a mapper alternative)")
     eq = Equations(list(spec.inputs), list(spec.outputs), covers, comps)
-    if opts.complements:
-        for name in spec.outputs:
-            xf = _xor_form(spec.table(name), spec.inputs, _scaled(aopts, clock))
-            if xf is not None:
-                eq.xor_forms[name] = xf
     if opts.share and len(spec.outputs) > 1 and not multi:  # the multi-output step shares
-        _share(spec, eq, prime_sets, opts)
+        _stopped(steps_end, limited, "shared covers", _share, spec, eq, prime_sets, replace(
+            opts, time_limit=max(clock.floor(MIN_STEP_SECONDS, HAZARD_RESERVE),
+                                 clock.cap(opts.time_limit, HAZARD_RESERVE))))
     if multi:
+        # first after the per-output covers: the product count is what the step is for, so
+        # under load the mapper's alternatives below are cut, not it
         per_output = Equations(eq.inputs, eq.outputs, dict(eq.covers), eq.complements,
                                eq.xor_forms)
-        # their own caps are CPU work too (stretched like the budget)
-        slow = clock.slowdown()
-        limited.extend(_multi_output(spec, eq, replace(
-            opts, time_limit=opts.time_limit * slow, multi_time_limit=min(
-                opts.multi_time_limit * slow, max(1.0, MULTI_SHARE * clock.left())))))
+        # a multi-output cover to keep in hand should the step below be stopped (and one
+        # more start for it): the per-output covers' and the PLA's cubes raised to
+        # multi-output primes, then a greedy, irredundant cover of them
+        quick = _stopped(steps_end, limited, "quick multi-output cover", _quick_multi, spec,
+                         eq)
+        # its preparation (the primes' table, the covering matrix, the reductions: 1.1 s of
+        # CPU on alu4) has no time check, so under load its limit keeps well inside the
+        # wall clock left; alu4's 575 products come at a limit of 0.5 s as at 4 s
+        mt = min(clock.cap(min(opts.time_limit, opts.multi_time_limit), HAZARD_RESERVE),
+                 max(clock.floor(0.5, HAZARD_RESERVE), MULTI_SHARE * clock.left(HAZARD_RESERVE)),
+                 max(0.2, MULTI_WALL_SHARE * clock.wall_left(HAZARD_RESERVE)))
+        got = _stopped(steps_end, limited, "multi-output cover", _multi_output, spec, eq,
+                       replace(opts, time_limit=mt, multi_time_limit=mt), quick)
+        if got is not None:
+            new, timed = got
+            limited.extend(timed)
+            eq.covers.update(new)
+        if quick is not None and _cover_cost(quick) < _cover_cost(
+                [eq.covers[o].cubes for o in spec.outputs]):
+            for o, cubes in zip(spec.outputs, quick):
+                eq.covers[o] = Cover(cubes, False, "quick multi-output", eq.covers[o].seconds)
         if any(eq.covers[o].cubes != per_output.covers[o].cubes for o in eq.outputs):
-            slow = clock.slowdown()
-            _share(spec, per_output, prime_sets, replace(opts, time_limit=min(
-                opts.time_limit * slow, opts.multi_time_limit * slow,
-                max(MIN_STEP_SECONDS, SHARE_SHARE * clock.left()))), limited)
+            _stopped(steps_end, limited, "shared per-output covers", _share, spec, per_output,
+                     prime_sets, replace(opts, time_limit=min(
+                         clock.cap(min(opts.time_limit, opts.multi_time_limit), HAZARD_RESERVE),
+                         max(clock.floor(MIN_STEP_SECONDS, HAZARD_RESERVE),
+                             SHARE_SHARE * clock.left(HAZARD_RESERVE)))), limited)
             for o in eq.outputs:  # not the multi-output minimum, whatever each one is alone
                 c = per_output.covers[o]
                 per_output.covers[o] = Cover(c.cubes, False, "per-output", c.seconds)
             eq.alternative = per_output
+    if opts.complements:
+        _alternatives(spec, tables, eq, comp_sets, opts, clock, limited)
     eq.shared_terms = count_shared(eq)
-    if opts.hazard_free:
-        hopts = replace(opts, time_limit=min(opts.time_limit, opts.hazard_time_limit,
-                                             max(HAZARD_BUDGET / m, 0.2)) * clock.slowdown())
-        # products built for some output: closing a hazard with one costs an OR input only
-        built = list(dict.fromkeys(c for o in spec.outputs for c in eq.covers[o].cubes)) \
-            if multi else []
-        for name in spec.outputs:
-            table = spec.table(name)
-            eq.hazard_free[name] = _with_consensus(eq.covers[name], table, n, prime_sets[name],
-                                                   hopts, limited, name, built)
-            if name in comps:
-                eq.hazard_free_complements[name] = _with_consensus(
-                    comps[name], _complement(table), n, comp_sets[name], _alt(hopts), limited,
-                    f"complement of {name}")
     alt = eq.alternative
+    if opts.hazard_free:
+        _consensus_terms(spec, eq, comp_sets, prime_sets, opts, clock, limited, multi)
     if alt is not None:
         alt.shared_terms = count_shared(alt)
         alt.hazard_free_complements = eq.hazard_free_complements
-        if opts.hazard_free:
-            for name in spec.outputs:
-                alt.hazard_free[name] = _with_consensus(
-                    alt.covers[name], spec.table(name), n, prime_sets[name], hopts, limited,
-                    f"{name} (per-output covers)")
         verify(spec, alt)
+    if clock.wall_left() < 0:
+        limited.append(f"minimisation wall clock ({opts.wall_limit:g} s)")
     eq.time_limited = limited
     if alt is not None:
         alt.time_limited = limited
@@ -138,71 +151,190 @@ def minimise(spec: Spec, opts: MinimiseOptions | None = None) -> Equations:
     return eq
 
 
+def _stopped(until: float | None, limited: list[str], label: str, step, *args):
+    """``step(*args)``, or None (and ``label`` noted in ``limited``) when the hard end of the
+    wall clock comes first."""
+    try:
+        with hard_stop(until):
+            return step(*args)
+    except WallClockOut:
+        limited.append(f"{label} (left out: wall clock)")
+        return None
+
+
+def _quick_cover(spec: Spec, name: str, table: np.ndarray, n: int) -> Cover:
+    """A valid cover of one output without any search, for when the wall clock is out: a
+    PLA's own rows (inside on ∪ dc by definition), else each on-minterm grown greedily."""
+    f = spec.functions.get(name)
+    if spec.kind == "pla" and f is not None and f.on is not None and not f.off \
+            and f.rest == 0:
+        cubes = list(dict.fromkeys(f.on))
+    else:
+        on = np.flatnonzero(table == 1).astype(np.int64)
+        cubes = [Cube(int(a), int(b)) for a, b in zip(*expand_primes(table != 0, on, n))]
+    return Cover(cubes, False, "quick", 0.0)
+
+
+def _alternatives(spec: Spec, tables: np.ndarray, eq: Equations, comp_sets: dict,
+                  opts: MinimiseOptions, clock: Clock, limited: list[str]) -> None:
+    """The mapper's alternative forms of every output (complement covers, XOR forms), in
+    what is left of the budget: each output gets an equal share of the wall clock left, and
+    once it is out the rest are left without (the mapper then builds the covers
+    themselves)."""
+    n, m = spec.n, len(spec.outputs)
+    end = clock.end(HAZARD_RESERVE)
+    comp_own = _stopped(end, [], "", _own_primes, tables != 1, n) \
+        if n <= ALT_EXACT_MAX_INPUTS else None
+    # the alternatives share one budget, so many outputs do not multiply it
+    alt_each = min(opts.alt_time_limit, ALT_BUDGET / m)
+    skipped: list[str] = []
+    for i, name in enumerate(spec.outputs):
+        if clock.wall_left(HAZARD_RESERVE) <= 0:
+            skipped.append(name)
+            continue
+        # stretched by the load seen so far (under load 10 espresso's 3 s ran out on alu4's
+        # f7: 517 more parts), never past this output's share of the wall clock left
+        t = max(0.05, min(clock.cap(alt_each, HAZARD_RESERVE),
+                          ALT_SHARE * clock.wall_left(HAZARD_RESERVE) / (m - i)))
+        aopts = replace(opts, alt_time_limit=t, time_limit=min(opts.time_limit, t))
+        got = _stopped(end, [], "", _minimise_alt, _complement(tables[i]), n, aopts,
+                       comp_own[i] if comp_own is not None else None)
+        if got is None:
+            skipped.append(name)
+            continue
+        eq.complements[name], comp_sets[name] = got
+        c = eq.complements[name]
+        if c.method == "greedy" or c.method.endswith("(time limit)"):
+            limited.append(f"complement cover of {name} (a mapper alternative)")
+    if skipped:
+        limited.append(f"complement covers of {', '.join(skipped)} (mapper alternatives, "
+                       "left out: wall clock)")
+    skipped = []
+    for i, name in enumerate(spec.outputs):
+        t = max(0.05, min(clock.cap(alt_each, HAZARD_RESERVE),
+                          ALT_SHARE * clock.wall_left(HAZARD_RESERVE) / (m - i)))
+        got = _stopped(end, [], "", _xor_form, tables[i], spec.inputs, replace(
+            opts, alt_time_limit=t, time_limit=min(opts.time_limit, t))) \
+            if clock.wall_left(HAZARD_RESERVE) > 0 else None
+        if got is not None:
+            eq.xor_forms[name] = got
+        elif _has_xor(tables[i], n):
+            skipped.append(name)
+    if skipped:
+        limited.append(f"XOR forms of {', '.join(skipped)} (mapper alternatives, left out: "
+                       "wall clock)")
+
+
+def _consensus_terms(spec: Spec, eq: Equations, comp_sets: dict, prime_sets: dict,
+                     opts: MinimiseOptions, clock: Clock, limited: list[str],
+                     multi: bool) -> None:
+    """Every cover (and complement cover) with the consensus terms that close its hazards,
+    in the last second of the wall clock; a cover left without them (the clock is out) is
+    named in ``limited`` and the mapper builds the cover itself."""
+    n, m = spec.n, len(spec.outputs)
+    alt = eq.alternative
+    jobs = len(spec.outputs) * (2 if alt is not None else 1)
+    hopts = replace(opts, time_limit=max(0.05, min(
+        clock.cap(min(opts.time_limit, opts.hazard_time_limit, max(HAZARD_BUDGET / m, 0.2))),
+        HAZARD_SHARE * clock.wall_left() / jobs)))
+    end = clock.end()
+    # products built for some output: closing a hazard with one costs an OR input only
+    built = list(dict.fromkeys(c for o in spec.outputs for c in eq.covers[o].cubes)) \
+        if multi else []
+    skipped: list[str] = []
+
+    def close(cover: Cover, table, primes, copts, label, shared=()) -> Cover | None:
+        got = _stopped(end, [], "", _with_consensus, cover, table, n, primes, copts, limited,
+                       label, shared)
+        if got is None:
+            skipped.append(label)
+        return got
+
+    for name in spec.outputs:
+        table = spec.table(name)
+        got = close(eq.covers[name], table, prime_sets[name], hopts, name, built)
+        if got is not None:
+            eq.hazard_free[name] = got
+        if name in eq.complements:
+            got = close(eq.complements[name], _complement(table), comp_sets[name], _alt(hopts),
+                        f"complement of {name}")
+            if got is not None:
+                eq.hazard_free_complements[name] = got
+    if alt is not None:
+        for name in spec.outputs:
+            got = close(alt.covers[name], spec.table(name), prime_sets[name], hopts,
+                        f"{name} (per-output covers)")
+            if got is not None:
+                alt.hazard_free[name] = got
+    if skipped:
+        limited.append(f"hazard-free covers of {', '.join(skipped)} (left out: wall clock)")
+
+
+def _has_xor(table: np.ndarray, n: int) -> bool:
+    """Whether ``_xor_form`` would peel some input (then leaving it out is worth a note)."""
+    for k in range(n):
+        shaped = table.reshape(1 << k, 2, 1 << (n - 1 - k))
+        a, b = shaped[:, 0, :], shaped[:, 1, :]
+        both = (a != DC) & (b != DC)
+        if both.any() and not (a[both] == b[both]).any():
+            return True
+    return False
+
+
 #: Shares of the time budget still left: the per-output covers (together), the multi-output
-#: step, the program sharing the per-output covers; no step gets less than
-#: ``MIN_STEP_SECONDS``.
+#: step, the program sharing the per-output covers, the mapper's alternative forms (all
+#: outputs together) and the consensus terms (all covers together); no step gets less than
+#: ``MIN_STEP_SECONDS`` while the wall clock lasts.
 COVER_SHARE = 0.45
 MULTI_SHARE = 0.6
+MULTI_WALL_SHARE = 0.35
+COVER_WALL_SHARE = 0.3
+#: Past this share of the wall clock the per-output covers left are greedy (no program).
+COVER_WALL_END = 0.3
 SHARE_SHARE = 0.5
+ALT_SHARE = 0.6
+HAZARD_SHARE = 0.5
 MIN_STEP_SECONDS = 0.3
+#: Wall seconds before the hard end kept for the consensus terms (every step before them
+#: ends by then).
+HAZARD_RESERVE = 1.0
 
 
-SLOWDOWN_CAP = 2.5
-SLOWDOWN_MIN_CPU = 0.3
+def _quick_multi(spec: Spec, eq: Equations) -> list[list[Cube]] | None:
+    """``quick_multi.quick_multi_cover`` from the per-output covers and a PLA's own rows."""
+    tables = np.array([spec.table(o) for o in spec.outputs])
+    starts = [[eq.covers[o].cubes for o in spec.outputs]]
+    if spec.kind == "pla":
+        starts.append([spec.functions[o].on for o in spec.outputs])
+    return quick_multi_cover(spec.n, tables == 1, tables != 0, starts)
 
 
-class _Clock:
-    """What is left of ``MinimiseOptions.budget``, counted in CPU seconds of this process
-    (the same work on an idle machine or on one shared with other jobs) and handed out as
-    wall-clock seconds (the solvers' limits are wall clock): the CPU seconds left times how
-    much slower than the CPU the wall clock has run so far. Infinite without a budget."""
-
-    def __init__(self, budget: float | None):
-        self.budget = budget
-        self.wall0, self.cpu0 = time.perf_counter(), time.process_time()
-
-    def slowdown(self) -> float:
-        """Wall seconds per CPU second of this call so far, between 1 and ``SLOWDOWN_CAP``
-        (1 until ``SLOWDOWN_MIN_CPU`` has run: a short stall made alu4's multi-output step
-        take 18 s stretched limits once the machine went quiet)."""
-        cpu = time.process_time() - self.cpu0
-        wall = time.perf_counter() - self.wall0
-        if cpu < SLOWDOWN_MIN_CPU:
-            return 1.0
-        return min(SLOWDOWN_CAP, max(1.0, wall / cpu))
-
-    def left(self) -> float:
-        if not self.budget:
-            return float("inf")
-        return max(0.0, self.budget - (time.process_time() - self.cpu0)) * self.slowdown()
-
-
-def _scaled(opts: MinimiseOptions, clock: _Clock) -> MinimiseOptions:
-    """The alternatives' time limits stretched by the slowdown seen so far."""
-    f = clock.slowdown()
-    return replace(opts, time_limit=opts.time_limit * f, alt_time_limit=opts.alt_time_limit * f)
-
-
-def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions) -> list[str]:
-    """Replace the per-output covers by the multi-output cover when it has fewer distinct
-    products (then literals plus OR inputs); every output's ``proven`` then says whether the
-    multi-output minimum is proven. Returns the steps whose time limit ran out."""
+def _multi_output(spec: Spec, eq: Equations, opts: MinimiseOptions,
+                  quick: list[list[Cube]] | None = None
+                  ) -> tuple[dict[str, Cover], list[str]]:
+    """The multi-output covers that replace the per-output ones when they have fewer
+    distinct products (then literals plus OR inputs); every output's ``proven`` then says
+    whether the multi-output minimum is proven. Returns (covers, the steps whose time limit
+    ran out); ``eq`` is left as it is."""
     n = spec.n
     tables = np.array([spec.table(o) for o in spec.outputs])
     on, region = tables == 1, tables != 0
     start = [eq.covers[o].cubes for o in spec.outputs]
     dc = [spec.functions[o].dc for o in spec.outputs] if spec.kind == "pla" else None
     seeds = [[spec.functions[o].on for o in spec.outputs]] if spec.kind == "pla" else []
+    if quick is not None:
+        seeds.append(quick)
     res = minimise_multi(n, on, region, start, dc, min(opts.time_limit, opts.multi_time_limit),
                          opts.prime_limit, seeds=seeds)
     old = _cover_cost([eq.covers[o].cubes for o in spec.outputs])
     new = _cover_cost([res.output_cubes(i) for i in range(len(spec.outputs))])
+    covers = {}
     for i, o in enumerate(spec.outputs):
         c = eq.covers[o]
         cubes = res.output_cubes(i) if new < old else c.cubes
-        eq.covers[o] = Cover(cubes, res.proven, res.method if new < old
-                             else c.method, c.seconds + res.seconds / len(spec.outputs))
-    return res.time_limited
+        covers[o] = Cover(cubes, res.proven, res.method if new < old
+                          else c.method, c.seconds + res.seconds / len(spec.outputs))
+    return covers, res.time_limited
 
 
 def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
@@ -213,9 +345,10 @@ def _cover_cost(covers: list[list[Cube]]) -> tuple[int, int]:
 
 
 #: Every output's primes come from one ternary table (``implicants.own_primes``) up to this
-#: many cubes (3**15: 14 million entries, a fraction of a second); beyond, per output by the
-#: Shannon recursion of ``primes.py``.
-OWN_TABLE_MAX_CUBES = 3 ** 15
+#: many cubes (3**16: 43 million entries, within the table's byte cap for up to 16 outputs);
+#: beyond, per output by the Shannon recursion of ``primes.py``. At 16 inputs the table
+#: halved the per-output covers' CPU on a random 11-output PLA (3.8 s against 7.3 s).
+OWN_TABLE_MAX_CUBES = 3 ** 16
 
 
 def _own_primes(regions: np.ndarray, n: int) -> list | None:
