@@ -68,77 +68,123 @@ def conflict(p: Piece, q: Piece, clearance: float) -> bool:
 def assign_planes(pieces: list[Piece], clearance: float, base: int) -> dict[str, int]:
     """A plane per piece (``base`` and up) such that no two pieces that could meet share one;
     few planes by a greedy colouring of the conflict graph."""
-    adj: dict[str, set[str]] = {p.key: set() for p in pieces}
     if not pieces:
         return {}
-    for i, k in conflicting_pairs(pieces, clearance):
-        adj[pieces[i].key].add(pieces[k].key)
-        adj[pieces[k].key].add(pieces[i].key)
-    colour = dsatur(adj, [p.key for p in pieces])
-    return {k: base + c for k, c in colour.items()}
+    pairs = conflicting_pairs(pieces, clearance)
+    a = np.array([i for i, _ in pairs], dtype=np.int64)
+    b = np.array([k for _, k in pairs], dtype=np.int64)
+    colour = dsatur_indexed(len(pieces), a, b)
+    return {p.key: base + c for p, c in zip(pieces, colour)}
+
+
+#: Rectangles queried against the spatial index at once (bounds the candidate arrays).
+_BLOCK = 4096
 
 
 def conflicting_pairs(pieces: list[Piece], clearance: float) -> list[tuple[int, int]]:
-    """Every pair (i < k) of pieces that :func:`conflict` says could meet, found in bulk:
-    a spatial index (shapely STRtree) on each piece's box grown by its sweep and half the
-    clearance gives the candidates, then :func:`conflict`'s test on every candidate at once
-    (numpy). Thousands of rods make millions of pairs; a test per pair in Python took
-    seconds per assembly."""
-    box = np.array([_bbox(p) for p in pieces])
-    sw = np.array([p.sweep for p in pieces], dtype=float)
-    grow = np.concatenate([sw, sw], axis=1) + clearance / 2 + 1e-9  # a little more: a superset
-    grown = box + grow * np.array([-1.0, -1.0, 1.0, 1.0])
-    geoms = shapely.box(*grown.T)
-    qi, qk = shapely.STRtree(geoms).query(geoms, predicate="intersects")
-    keep = qi < qk
-    qi, qk = qi[keep], qk[keep]
-    if not len(qi):
+    """Every pair (i < k) of pieces that :func:`conflict` says could meet, found in bulk.
+
+    Each piece's rectangles (not its bounding box: a fan-out bar's arm and bar make an L whose
+    box covers a whole channel's height) go into one spatial index (shapely STRtree), each
+    grown by its piece's sweep and half the clearance, so two rectangles are candidates only
+    if they could come that near; :func:`conflict`'s gap test then runs on the candidate
+    rectangle pairs at once (numpy), in blocks, so memory stays bounded by the block and the
+    conflicts found. A rod and its own fan-out bar always conflict (pinned, on two plates)
+    where their grown boxes meet, as :func:`conflict` on a candidate pair says. Boxes of whole
+    pieces, all candidates tested at once, took 4.7 GB and minutes on a design of 9000
+    cells."""
+    n = len(pieces)
+    if n < 2:
         return []
-    order = np.lexsort((qk, qi))
-    qi, qk = qi[order], qk[order]
+    owner = np.array([i for i, p in enumerate(pieces) for _ in p.rects], dtype=np.int64)
+    rects = np.array([r for p in pieces for r in p.rects], dtype=float).reshape(-1, 4)
+    sw = np.array([p.sweep for p in pieces], dtype=float)
     nets = {net: j for j, net in enumerate(sorted({p.net for p in pieces}))}
-    net = np.array([nets[p.net] for p in pieces])
-    rod = np.array([p.rod for p in pieces])
-    width = max(len(p.rects) for p in pieces)
-    rects = np.array([[*p.rects, *[p.rects[0]] * (width - len(p.rects))] for p in pieces],
-                     dtype=float)  # (n, width, 4): a piece's first rectangle repeats
-    same = net[qi] == net[qk]
-    hit = same & (rod[qi] != rod[qk])  # a rod and its own fan-out bar: pinned, on two plates
-    sx = np.where(same, 0.0, sw[qi, 0] + sw[qk, 0])  # one net moves as one
-    sy = np.where(same, 0.0, sw[qi, 1] + sw[qk, 1])
-    for u in range(width):
-        a = rects[qi, u]
-        for v in range(width):
-            b = rects[qk, v]
-            dx = np.maximum(np.maximum(a[:, 0] - b[:, 2], b[:, 0] - a[:, 2]), 0.0)
-            dy = np.maximum(np.maximum(a[:, 1] - b[:, 3], b[:, 1] - a[:, 3]), 0.0)
-            hit |= np.hypot(np.maximum(0.0, dx - sx), np.maximum(0.0, dy - sy)) < clearance
-    return list(zip(qi[hit].tolist(), qk[hit].tolist()))
+    net = np.array([nets[p.net] for p in pieces], dtype=np.int64)
+    rod = np.array([p.rod for p in pieces], dtype=bool)
+    grow = np.concatenate([sw, sw], axis=1) + clearance / 2 + 1e-9  # a little more: a superset
+    sign = np.array([-1.0, -1.0, 1.0, 1.0])
+    grown = rects + grow[owner] * sign
+    geoms = shapely.box(*grown.T)
+    tree = shapely.STRtree(geoms)
+    found: list[np.ndarray] = []
+    for lo in range(0, len(geoms), _BLOCK):
+        qa, qb = tree.query(geoms[lo:lo + _BLOCK], predicate="intersects")
+        qa = qa + lo
+        a, b = owner[qa], owner[qb]
+        keep = a < b
+        qa, qb, a, b = qa[keep], qb[keep], a[keep], b[keep]
+        same = net[a] == net[b]
+        sx = np.where(same, 0.0, sw[a, 0] + sw[b, 0])  # one net moves as one
+        sy = np.where(same, 0.0, sw[a, 1] + sw[b, 1])
+        ra, rb = rects[qa], rects[qb]
+        dx = np.maximum(np.maximum(ra[:, 0] - rb[:, 2], rb[:, 0] - ra[:, 2]), 0.0)
+        dy = np.maximum(np.maximum(ra[:, 1] - rb[:, 3], rb[:, 1] - ra[:, 3]), 0.0)
+        hit = np.hypot(np.maximum(0.0, dx - sx), np.maximum(0.0, dy - sy)) < clearance
+        found.append(a[hit] * n + b[hit])
+    # a rod and its own fan-out bar: pinned, on two plates, wherever their boxes, grown as
+    # above, meet (the rod starts on its bar: they always do)
+    box = np.array([_bbox(p) for p in pieces], dtype=float)
+    gbox = box + grow * sign
+    by_net: dict[int, list[int]] = {}
+    for i in range(n):
+        by_net.setdefault(int(net[i]), []).append(i)
+    pa, pb = [], []
+    for members in by_net.values():
+        bars = [i for i in members if not rod[i]]
+        rods = [i for i in members if rod[i]]
+        pa += [i for i in bars for _ in rods]
+        pb += [k for _ in bars for k in rods]
+    if pa:
+        a, b = np.minimum(pa, pb), np.maximum(pa, pb)
+        meet = ((gbox[a, 0] <= gbox[b, 2]) & (gbox[b, 0] <= gbox[a, 2])
+                & (gbox[a, 1] <= gbox[b, 3]) & (gbox[b, 1] <= gbox[a, 3]))
+        found.append(a[meet] * n + b[meet])
+    codes = np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.int64)
+    return list(zip((codes // n).tolist(), (codes % n).tolist()))
 
 
 def dsatur(adj: dict[str, set[str]], order: list[str]) -> dict[str, int]:
-    """Greedy colouring in DSATUR order (Brélaz): next the uncoloured vertex whose neighbours
-    already use the most colours, then the one of most neighbours, then the first in
-    ``order``; each takes the smallest colour none of its neighbours has. A heap with stale
-    entries skipped keeps it O((V + E) log V) (networkx's DSATUR rescans every vertex per step:
-    16 s on a design of 856 rods)."""
-    rank = {k: i for i, k in enumerate(order)}
-    seen: dict[str, set[int]] = {k: set() for k in order}
-    heap = [(0, -len(adj[k]), rank[k], k) for k in order]
+    """:func:`dsatur_indexed` on a graph of named vertices (``order``: the tie-break)."""
+    index = {k: i for i, k in enumerate(order)}
+    a = np.array([index[k] for k in order for nb in adj[k] if index[nb] > index[k]],
+                 dtype=np.int64)
+    b = np.array([index[nb] for k in order for nb in adj[k] if index[nb] > index[k]],
+                 dtype=np.int64)
+    return dict(zip(order, dsatur_indexed(len(order), a, b)))
+
+
+def dsatur_indexed(n: int, a: np.ndarray, b: np.ndarray) -> list[int]:
+    """Greedy colouring of vertices ``0..n-1`` with edges ``a[i]-b[i]`` (no repeats) in
+    DSATUR order (Brélaz): next the uncoloured vertex whose neighbours already use the most
+    colours, then the one of most neighbours, then the lowest index; each takes the smallest
+    colour none of its neighbours has. A heap with stale entries skipped keeps it
+    O((V + E) log V) (networkx's DSATUR rescans every vertex per step: 16 s on a design of 856
+    rods); the neighbours are arrays (CSR), not sets of names, so a million edges fit in tens
+    of megabytes."""
+    ends = np.concatenate([a, b])
+    nbrs = np.concatenate([b, a])
+    order = np.argsort(ends, kind="stable")
+    start = np.searchsorted(ends[order], np.arange(n + 1)).tolist()
+    flat = nbrs[order].tolist()
+    degree = [start[k + 1] - start[k] for k in range(n)]
+    seen: list[set[int]] = [set() for _ in range(n)]
+    heap = [(0, -degree[k], k) for k in range(n)]
     heapq.heapify(heap)
-    colour: dict[str, int] = {}
+    colour = [-1] * n
     while heap:
-        sat, _, _, k = heapq.heappop(heap)
-        if k in colour or -sat != len(seen[k]):
+        sat, _, k = heapq.heappop(heap)
+        if colour[k] >= 0 or -sat != len(seen[k]):
             continue  # coloured already, or an entry from before its saturation grew
+        used = seen[k]
         c = 0
-        while c in seen[k]:
+        while c in used:
             c += 1
         colour[k] = c
-        for nb in adj[k]:
-            if nb not in colour and c not in seen[nb]:
+        for nb in flat[start[k]:start[k + 1]]:
+            if colour[nb] < 0 and c not in seen[nb]:
                 seen[nb].add(c)
-                heapq.heappush(heap, (-len(seen[nb]), -len(adj[nb]), rank[nb], nb))
+                heapq.heappush(heap, (-len(seen[nb]), -degree[nb], nb))
     return colour
 
 
