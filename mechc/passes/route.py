@@ -18,6 +18,19 @@ Each conflict is an edge of a graph whose vertices are the pieces; a greedy colo
 graph (DSATUR order: the most constrained piece first) gives the planes, colour c on
 plane ``base + c``. The rectangles are the pieces' bounding boxes (exact for these
 axis-aligned bars), so the test is conservative only in the sweep, never short.
+
+A fan-out bar is an arm (horizontal, from the driver to the channel) and a vertical bar. Taken
+as one piece, every arm crosses the bars of the nets in the slots before it in its channel, so
+a channel of k nets whose bars span the column needs k planes (216 on a 9000-cell multiplier),
+and every rod crossing a bar is an edge (18 million). So the pieces are also coloured as two
+families on separate planes: the horizontal pieces (rods, and the arms that meet another net's
+bar) and the vertical bars (each with its arm where the arm meets none: one plate, as before).
+Bars of one channel are a channel apart and never meet, and horizontal pieces meet only near
+their own row, so both graphs stay sparse and their colourings small (7 and 1 planes on that
+multiplier). An arm on a plane of its own is a plate fastened to its bar where they overlap,
+as an arm is to its driver's slider. The one graph of all pieces is still coloured while it is
+small (``ONE_GRAPH_EDGES``) and kept where it needs no more planes, so small designs keep
+their planes.
 """
 
 from __future__ import annotations
@@ -37,13 +50,20 @@ Rect = tuple[float, float, float, float]  # x0, y0, x1, y1
 
 @dataclass(frozen=True)
 class Piece:
-    """A net's fan-out bar (``rod`` empty: the arm and vertical bar, one body) or one rod."""
+    """A net's fan-out bar (neither ``rod`` nor ``arm``: the vertical bar), the arm from the
+    driver to it (``arm``), or one rod (``rod``)."""
 
     key: str
     net: str
     rects: tuple[Rect, ...]  # at the design pose
     sweep: tuple[float, float]  # how far it can move from the design pose, either way, x and y
     rod: bool
+    arm: bool = False
+
+    @property
+    def bar(self) -> bool:
+        """The vertical fan-out bar, which the net's rods are pinned to."""
+        return not (self.rod or self.arm)
 
 
 def _gap(a: Rect, b: Rect, sx: float, sy: float) -> float:
@@ -57,8 +77,8 @@ def _gap(a: Rect, b: Rect, sx: float, sy: float) -> float:
 def conflict(p: Piece, q: Piece, clearance: float) -> bool:
     """Whether ``p`` and ``q`` could come within ``clearance`` of each other in some state."""
     if p.net == q.net:
-        if p.rod != q.rod:  # a rod and its own fan-out bar: pinned, one plate over the other
-            return True
+        if (p.rod and q.bar) or (p.bar and q.rod):  # a rod and its own fan-out bar: pinned,
+            return True  # one plate over the other
         sx = sy = 0.0  # one net moves as one
     else:
         sx, sy = p.sweep[0] + q.sweep[0], p.sweep[1] + q.sweep[1]
@@ -66,15 +86,68 @@ def conflict(p: Piece, q: Piece, clearance: float) -> bool:
 
 
 def assign_planes(pieces: list[Piece], clearance: float, base: int) -> dict[str, int]:
-    """A plane per piece (``base`` and up) such that no two pieces that could meet share one;
-    few planes by a greedy colouring of the conflict graph."""
+    """A plane per piece (``base`` and up) such that no two pieces that could meet share one,
+    by greedy colourings of conflict graphs (see the module docstring): the split into a
+    horizontal and a vertical family always, and one graph of all pieces (each arm with its
+    bar) while that graph stays under ``ONE_GRAPH_EDGES`` edges per piece; the colouring of
+    fewer planes is kept, the one graph's on a tie."""
     if not pieces:
         return {}
-    pairs = conflicting_pairs(pieces, clearance)
-    a = np.array([i for i, _ in pairs], dtype=np.int64)
-    b = np.array([k for _, k in pairs], dtype=np.int64)
-    colour = dsatur_indexed(len(pieces), a, b)
-    return {p.key: base + c for p, c in zip(pieces, colour)}
+    bar_of = {p.net: p for p in pieces if p.bar}
+    arm_of = {p.net: p for p in pieces if p.arm}
+    split = _split_colouring(pieces, bar_of, clearance)
+    whole = [p for p in pieces if p.rod] + [_merged(p, arm_of.get(p.net)) for p in pieces
+                                            if p.bar]
+    rank = {p.key: i for i, p in enumerate(pieces)}
+    whole.sort(key=lambda p: rank[p.key])
+    codes = _conflict_codes(whole, clearance, limit=ONE_GRAPH_EDGES * len(whole))
+    if codes is not None:
+        colour = dsatur_indexed(len(whole), codes // len(whole), codes % len(whole))
+        if max(colour) + 1 <= max(split.values()) + 1:
+            one = {p.key: c for p, c in zip(whole, colour)}
+            one.update((a.key, one[bar_of[a.net].key]) for a in arm_of.values() if a.net in bar_of)
+            return {k: base + c for k, c in one.items()}
+    return {k: base + c for k, c in split.items()}
+
+
+#: The one graph of all pieces is coloured too while it has fewer edges than this per piece
+#: (rods crossing long fan-out bars make it grow with the square of the design: 470 per piece,
+#: 18 million edges, on a multiplier of 9000 cells; 43 per piece on the 1322-cell ALU).
+ONE_GRAPH_EDGES = 64
+
+
+def _merged(bar: Piece, arm: Piece | None) -> Piece:
+    """A net's arm and bar as one piece (one plane), keyed by the bar."""
+    if arm is None:
+        return bar
+    return Piece(bar.key, bar.net, (*arm.rects, *bar.rects), bar.sweep, False)
+
+
+def _split_colouring(pieces: list[Piece], bar_of: dict[str, Piece],
+                     clearance: float) -> dict[str, int]:
+    """Colours (from 0) of the two families: the horizontal pieces (rods, and arms that meet
+    another net's bar), then, on colours above theirs, the vertical bars (each with its arm
+    where the arm meets no other net's bar)."""
+    bars = list(bar_of.values())
+    arms = [p for p in pieces if p.arm]
+    codes = _conflict_codes(arms + bars, clearance)
+    n = len(arms) + len(bars)
+    i, k = codes // max(n, 1), codes % max(n, 1)
+    crossing = set(i[(i < len(arms)) & (k >= len(arms))].tolist())  # (arm, bar): arms first
+    free = {p.net: p for j, p in enumerate(arms) if j not in crossing and p.net in bar_of}
+    flat = [p for p in pieces if p.rod] + [p for p in arms if p.net not in free]
+    vertical = [_merged(p, free.get(p.net)) for p in bars]
+    out: dict[str, int] = {}
+    first = 0
+    for family in (flat, vertical):
+        if not family:
+            continue
+        pairs = _conflict_codes(family, clearance)
+        colour = dsatur_indexed(len(family), pairs // len(family), pairs % len(family))
+        out.update((p.key, first + c) for p, c in zip(family, colour))
+        first += max(colour) + 1
+    out.update((p.key, out[bar_of[p.net].key]) for p in free.values())
+    return out
 
 
 #: Rectangles queried against the spatial index at once (bounds the candidate arrays).
@@ -82,7 +155,17 @@ _BLOCK = 4096
 
 
 def conflicting_pairs(pieces: list[Piece], clearance: float) -> list[tuple[int, int]]:
-    """Every pair (i < k) of pieces that :func:`conflict` says could meet, found in bulk.
+    """Every pair (i < k) of pieces that :func:`conflict` says could meet (see
+    :func:`_conflict_codes`)."""
+    codes = _conflict_codes(pieces, clearance)
+    n = max(len(pieces), 1)
+    return list(zip((codes // n).tolist(), (codes % n).tolist()))
+
+
+def _conflict_codes(pieces: list[Piece], clearance: float,
+                    limit: int | None = None) -> np.ndarray | None:
+    """Every pair (i < k) of pieces that :func:`conflict` says could meet, as ``i * n + k``
+    in ascending order, found in bulk.
 
     Each piece's rectangles (not its bounding box: a fan-out bar's arm and bar make an L whose
     box covers a whole channel's height) go into one spatial index (shapely STRtree), each
@@ -92,16 +175,17 @@ def conflicting_pairs(pieces: list[Piece], clearance: float) -> list[tuple[int, 
     conflicts found. A rod and its own fan-out bar always conflict (pinned, on two plates)
     where their grown boxes meet, as :func:`conflict` on a candidate pair says. Boxes of whole
     pieces, all candidates tested at once, took 4.7 GB and minutes on a design of 9000
-    cells."""
+    cells. None when more than ``limit`` conflicts are found (the search stops there)."""
     n = len(pieces)
     if n < 2:
-        return []
+        return np.zeros(0, dtype=np.int64)
     owner = np.array([i for i, p in enumerate(pieces) for _ in p.rects], dtype=np.int64)
     rects = np.array([r for p in pieces for r in p.rects], dtype=float).reshape(-1, 4)
     sw = np.array([p.sweep for p in pieces], dtype=float)
     nets = {net: j for j, net in enumerate(sorted({p.net for p in pieces}))}
     net = np.array([nets[p.net] for p in pieces], dtype=np.int64)
     rod = np.array([p.rod for p in pieces], dtype=bool)
+    bar = np.array([p.bar for p in pieces], dtype=bool)
     grow = np.concatenate([sw, sw], axis=1) + clearance / 2 + 1e-9  # a little more: a superset
     sign = np.array([-1.0, -1.0, 1.0, 1.0])
     grown = rects + grow[owner] * sign
@@ -122,6 +206,8 @@ def conflicting_pairs(pieces: list[Piece], clearance: float) -> list[tuple[int, 
         dy = np.maximum(np.maximum(ra[:, 1] - rb[:, 3], rb[:, 1] - ra[:, 3]), 0.0)
         hit = np.hypot(np.maximum(0.0, dx - sx), np.maximum(0.0, dy - sy)) < clearance
         found.append(a[hit] * n + b[hit])
+        if limit is not None and sum(map(len, found)) > limit:
+            return None  # over the limit (a pair met by several rectangles counts more)
     # a rod and its own fan-out bar: pinned, on two plates, wherever their boxes, grown as
     # above, meet (the rod starts on its bar: they always do)
     box = np.array([_bbox(p) for p in pieces], dtype=float)
@@ -131,7 +217,7 @@ def conflicting_pairs(pieces: list[Piece], clearance: float) -> list[tuple[int, 
         by_net.setdefault(int(net[i]), []).append(i)
     pa, pb = [], []
     for members in by_net.values():
-        bars = [i for i in members if not rod[i]]
+        bars = [i for i in members if bar[i]]
         rods = [i for i in members if rod[i]]
         pa += [i for i in bars for _ in rods]
         pb += [k for _ in bars for k in rods]
@@ -140,8 +226,7 @@ def conflicting_pairs(pieces: list[Piece], clearance: float) -> list[tuple[int, 
         meet = ((gbox[a, 0] <= gbox[b, 2]) & (gbox[b, 0] <= gbox[a, 2])
                 & (gbox[a, 1] <= gbox[b, 3]) & (gbox[b, 1] <= gbox[a, 3]))
         found.append(a[meet] * n + b[meet])
-    codes = np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.int64)
-    return list(zip((codes // n).tolist(), (codes % n).tolist()))
+    return np.unique(np.concatenate(found)) if found else np.zeros(0, dtype=np.int64)
 
 
 def dsatur(adj: dict[str, set[str]], order: list[str]) -> dict[str, int]:
