@@ -21,16 +21,16 @@ axis-aligned bars), so the test is conservative only in the sweep, never short.
 
 A fan-out bar is an arm (horizontal, from the driver to the channel) and a vertical bar. Taken
 as one piece, every arm crosses the bars of the nets in the slots before it in its channel, so
-a channel of k nets whose bars span the column needs k planes (216 on a 9000-cell multiplier),
-and every rod crossing a bar is an edge (18 million). So the pieces are also coloured as two
-families on separate planes: the horizontal pieces (rods, and the arms that meet another net's
-bar) and the vertical bars (each with its arm where the arm meets none: one plate, as before).
-Bars of one channel are a channel apart and never meet, and horizontal pieces meet only near
-their own row, so both graphs stay sparse and their colourings small (7 and 1 planes on that
-multiplier). An arm on a plane of its own is a plate fastened to its bar where they overlap,
-as an arm is to its driver's slider. The one graph of all pieces is still coloured while it is
-small (``ONE_GRAPH_EDGES``) and kept where it needs no more planes, so small designs keep
-their planes.
+a channel of k nets whose bars span the column needs k planes (216 on a 6x6 multiplier of
+13,700 cells, its hazards left uncured), and every rod crossing a bar is an edge (18 million).
+So the pieces are also coloured as two families on separate planes: the horizontal pieces
+(rods, and the arms that meet another net's bar) and the vertical bars (each with its arm where
+the arm meets none: one plate, as before). Bars of one channel are a channel apart and never
+meet, and horizontal pieces meet only near their own row, so both graphs stay sparse and their
+colourings small (that multiplier: 14 planes in all, the cells' included). An arm on a plane of
+its own is a plate fastened to its bar where they overlap, as an arm is to its driver's slider.
+The one graph of all pieces is still coloured while it is small (``ONE_GRAPH_EDGES``) and kept
+where it needs no more planes, so small designs keep their planes.
 """
 
 from __future__ import annotations
@@ -112,7 +112,7 @@ def assign_planes(pieces: list[Piece], clearance: float, base: int) -> dict[str,
 
 #: The one graph of all pieces is coloured too while it has fewer edges than this per piece
 #: (rods crossing long fan-out bars make it grow with the square of the design: 470 per piece,
-#: 18 million edges, on a multiplier of 9000 cells; 43 per piece on the 1322-cell ALU).
+#: 18 million edges, on the 13,700-cell multiplier; 43 per piece on the 1322-cell ALU).
 ONE_GRAPH_EDGES = 64
 
 
@@ -174,7 +174,7 @@ def _conflict_codes(pieces: list[Piece], clearance: float,
     rectangle pairs at once (numpy), in blocks, so memory stays bounded by the block and the
     conflicts found. A rod and its own fan-out bar always conflict (pinned, on two plates)
     where their grown boxes meet, as :func:`conflict` on a candidate pair says. Boxes of whole
-    pieces, all candidates tested at once, took 4.7 GB and minutes on a design of 9000
+    pieces, all candidates tested at once, took 4.7 GB and minutes on a design of 13,700
     cells. None when more than ``limit`` conflicts are found (the search stops there)."""
     n = len(pieces)
     if n < 2:
