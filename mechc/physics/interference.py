@@ -168,13 +168,27 @@ class Interference:
         idx = np.flatnonzero(have)
         if len(idx) < 2:
             return
-        tree = shapely.STRtree(shapely.box(*swept[idx].T))
-        qi, qj = tree.query(shapely.box(*swept[idx].T), predicate="dwithin",
-                            distance=self.near)
-        pi, pj = idx[qi], idx[qj]
-        keep = ((pi < pj) & (self._layer_arr[pi] == self._layer_arr[pj])
-                & (self._body_arr[pi] != self._body_arr[pj]))
+        # one spatial index per plane: an index of every plane at once handed each rod every
+        # cell polygon it passes over (other planes), quadratic on a design of thousands
+        found_i, found_j = [], []
+        boxes_all = shapely.box(*swept[idx].T)
+        layer = self._layer_arr[idx]
+        for lay in np.unique(layer):
+            on = np.flatnonzero(layer == lay)
+            if len(on) < 2:
+                continue
+            geoms = boxes_all[on]
+            qi, qj = shapely.STRtree(geoms).query(geoms, predicate="dwithin",
+                                                  distance=self.near)
+            found_i.append(idx[on[qi]])
+            found_j.append(idx[on[qj]])
+        if not found_i:
+            return
+        pi, pj = np.concatenate(found_i), np.concatenate(found_j)
+        keep = (pi < pj) & (self._body_arr[pi] != self._body_arr[pj])
         pi, pj = pi[keep], pj[keep]
+        order = np.lexsort((pj, pi))  # a fixed order, whatever the indexes' traversal
+        pi, pj = pi[order], pj[order]
         by_pair: dict[tuple[str, str], list[tuple[int, int]]] = {}
         for a, b in zip(pi.tolist(), pj.tolist()):
             ba, bb = self._poly_body[a], self._poly_body[b]
