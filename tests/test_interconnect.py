@@ -70,6 +70,8 @@ def test_every_rod_is_a_body_of_plate_on_a_plane(designs, name):
         drivers = {j["a"] for j in part["joints"] if j["id"].endswith(".driver")}
         for d in drivers:
             fanout.setdefault(d, set()).add(part["data"]["fanout_plane"])
+            if "arm_plane" in part["data"]:  # an arm on a plane of its own
+                fanout[d].add(part["data"]["arm_plane"])
     cell_planes = set()
     for c in obj["cells"]:
         for b in c["geometry"]["bodies"]:

@@ -209,7 +209,8 @@ def _route_nets(gap_nets: dict[int, list[str]], col_x: list[float], col_w: list[
                 inputs: dict[str, Part], placed: dict[str, Part], demand: dict[str, Demand],
                 ctx: SynthContext, opts: MechOptions) -> dict[str, Part]:
     """Every net as parts: a fan-out bar (an arm and a vertical bar drawn onto the driver's
-    output body) in the channel after the driver's column, and per load a ``pushrod`` body of
+    output body, each on its own plane: two plates fastened where they meet) in the channel
+    after the driver's column, and per load a ``pushrod`` body of
     plate pinned to that bar and to the load's input slider, straight and horizontal. Planes
     from :func:`mechc.passes.route.assign_planes`; within a channel the nets with the most
     rods running right get the slots furthest right (shorter rods)."""
@@ -248,14 +249,15 @@ def _route_nets(gap_nets: dict[int, list[str]], col_x: list[float], col_w: list[
             ys = [ty] + [r[2][1] for r in rods]
             arm = rect(tx, ty - w / 2, x_bar + w / 2, ty + w / 2)
             bar = rect(x_bar - w / 2, min(ys) - w / 2, x_bar + w / 2, max(ys) + w / 2)
-            pieces.append(Piece(f"net.{net}", net, (_box(arm), _box(bar)), move, False))
+            pieces.append(Piece(f"net.{net}", net, (_box(bar),), move, False))
+            pieces.append(Piece(f"net.{net}.arm", net, (_box(arm),), move, False, arm=True))
             plans.append((net, owner, term, body, x_bar, arm, bar, rods))
     plane = assign_planes(pieces, opts.clearance, base)
     nets: dict[str, Part] = {}
     for net, owner, term, body, x_bar, arm, bar, rods in plans:
         layers = body.poly_layers or [body.layer] * len(body.outline)
         body.outline += [arm, bar]
-        body.poly_layers = layers + [plane[f"net.{net}"]] * 2
+        body.poly_layers = layers + [plane[f"net.{net}.arm"], plane[f"net.{net}"]]
         body.mass = ctx.mass(body.outline)
         part = Part()
         info = []
@@ -274,6 +276,8 @@ def _route_nets(gap_nets: dict[int, list[str]], col_x: list[float], col_w: list[
         part.data = {"driver": owner, "fanout_bar_x": round(x_bar, 3),
                      "fanout_plane": plane[f"net.{net}"], "demand": d.to_json(),
                      "loads": [f"{c}.{p}" for c, p in loads[net]], "rods": info}
+        if plane[f"net.{net}.arm"] != plane[f"net.{net}"]:  # the arm on a plane of its own
+            part.data["arm_plane"] = plane[f"net.{net}.arm"]
         nets[net] = part
     return nets
 

@@ -200,8 +200,9 @@ def add_bosses(mech: Mechanism) -> list[tuple[str, int]]:
             if j.id.endswith(".driver"):
                 drives[j.a] = drives.get(j.a, 0) + 1
         net_planes.update(b.layer for b in part.bodies)
-        if "fanout_plane" in part.data:
-            net_planes.add(part.data["fanout_plane"])
+        for key in ("fanout_plane", "arm_plane"):
+            if key in part.data:
+                net_planes.add(part.data[key])
     net_base = min(net_planes, default=max(planes) + 1)  # nets sit above every cell plane
     # one spatial index per plane over the polygons assembly drew, and the bounds of the
     # bosses added here in arrays (a scan of every polygon per pin, or of every boss added

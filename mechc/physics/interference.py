@@ -168,13 +168,27 @@ class Interference:
         idx = np.flatnonzero(have)
         if len(idx) < 2:
             return
-        tree = shapely.STRtree(shapely.box(*swept[idx].T))
-        qi, qj = tree.query(shapely.box(*swept[idx].T), predicate="dwithin",
-                            distance=self.near)
-        pi, pj = idx[qi], idx[qj]
-        keep = ((pi < pj) & (self._layer_arr[pi] == self._layer_arr[pj])
-                & (self._body_arr[pi] != self._body_arr[pj]))
+        # one spatial index per plane: an index of every plane at once handed each rod every
+        # cell polygon it passes over (other planes), quadratic on a design of thousands
+        found_i, found_j = [], []
+        boxes_all = shapely.box(*swept[idx].T)
+        layer = self._layer_arr[idx]
+        for lay in np.unique(layer):
+            on = np.flatnonzero(layer == lay)
+            if len(on) < 2:
+                continue
+            geoms = boxes_all[on]
+            qi, qj = shapely.STRtree(geoms).query(geoms, predicate="dwithin",
+                                                  distance=self.near)
+            found_i.append(idx[on[qi]])
+            found_j.append(idx[on[qj]])
+        if not found_i:
+            return
+        pi, pj = np.concatenate(found_i), np.concatenate(found_j)
+        keep = (pi < pj) & (self._body_arr[pi] != self._body_arr[pj])
         pi, pj = pi[keep], pj[keep]
+        order = np.lexsort((pj, pi))  # a fixed order, whatever the indexes' traversal
+        pi, pj = pi[order], pj[order]
         by_pair: dict[tuple[str, str], list[tuple[int, int]]] = {}
         for a, b in zip(pi.tolist(), pj.tolist()):
             ba, bb = self._poly_body[a], self._poly_body[b]
@@ -324,7 +338,9 @@ def pairs_sharing_a_plane(layers: list[frozenset[int]]) -> int:
     """How many pairs of bodies share at least one plane, counted without listing the pairs
     (a big design has thousands of bodies on the cells' planes: millions of pairs). Bodies on
     one plane count C(n, 2) per plane; the few on several planes (a driver with its fan-out
-    bar) are counted against every body on each of their planes, once per pair."""
+    bar) are counted against every body on each of their planes, once per pair, and against
+    each other by their distinct sets of planes (a matrix of those bodies against each other
+    was quadratic in the nets: gigabytes on a design of thousands)."""
     single: dict[int, int] = {}
     multi = [ls for ls in layers if len(ls) > 1]
     for ls in layers:
@@ -333,14 +349,13 @@ def pairs_sharing_a_plane(layers: list[frozenset[int]]) -> int:
             single[lay] = single.get(lay, 0) + 1
     count = sum(n * (n - 1) // 2 for n in single.values())
     count += sum(single.get(lay, 0) for ls in multi for lay in ls)
-    if multi:
-        planes = sorted(set().union(*multi))
-        col = {lay: k for k, lay in enumerate(planes)}
-        m = np.zeros((len(multi), len(planes)), dtype=np.float32)
-        for i, ls in enumerate(multi):
-            m[i, [col[lay] for lay in ls]] = 1.0
-        share = (m @ m.T) > 0
-        count += int(np.triu(share, 1).sum())
+    groups: dict[frozenset[int], int] = {}  # bodies on several planes, by their set of planes
+    for ls in multi:
+        groups[ls] = groups.get(ls, 0) + 1
+    sets = list(groups.items())
+    for i, (a, na) in enumerate(sets):
+        count += na * (na - 1) // 2
+        count += sum(na * nb for b, nb in sets[i + 1:] if a & b)
     return count
 
 
