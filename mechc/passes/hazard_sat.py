@@ -1,0 +1,216 @@
+"""Static hazards of a combinational netlist by SAT, for designs too wide to enumerate.
+
+The ternary check (:mod:`mechc.passes.ternary`) simulates every input vector and every
+single-input change: 2**n * n of them. Here the same question is put to a SAT solver, once per
+output, with no enumeration. The output's cone is written three times over shared input
+variables ``x`` (the start of the change) and one-hot selectors ``s`` (which input moves):
+
+- a binary copy at ``x`` (the moving input at 0) and one at ``x`` with the moving input at 1;
+- a dual-rail (ternary) copy, each net a pair (can be 0, can be 1): every input is its binary
+  value except the moving one, which can be both (X); each cell's pair is exact for its
+  ternary extension (a row of its table is possible where every input can take that row's
+  value), the same rule :func:`mechc.ir.ternary.evaluate3` simulates.
+
+A model of "output X in the ternary copy, equal in both binary copies" is a static hazard of
+that output on that change; none is a proof, over all 2**n * n changes, that the output has
+no static hazard. The cure (:mod:`mechc.passes.hazard_cure`) asks for hazards one at a time and
+excludes those the cubes chosen so far already hold (:meth:`HazardFinder.exclude_cube`), so it
+never lists them all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mechc.ir.cnf import TABLE_MAX_INPUTS, Cnf, NotEncodable, cell_table, encode_netlist
+from mechc.ir.netlist import CellInst, Netlist
+
+#: The solver python-sat runs (CaDiCaL, incremental with assumptions, as the logic proof's).
+SOLVER = "cadical195"
+
+
+@dataclass(frozen=True)
+class Change:
+    """One single-input change of an output: input ``moving`` rises from ``start`` (an integer,
+    input 0 the most significant bit, the moving input 0); ``value`` is the output at both
+    ends."""
+
+    output: str
+    moving: int
+    start: int
+    value: int
+
+
+def cone_cells(nl: Netlist, net: str) -> list[CellInst]:
+    """The cells ``net`` depends on, in the netlist's topological order."""
+    need: set[str] = set()
+    todo = [net]
+    while todo:
+        x = todo.pop()
+        drv = nl.driver.get(x)
+        if drv is None or drv[0] not in nl.cells or drv[0] in need:
+            continue
+        need.add(drv[0])
+        todo.extend(nl.cells[drv[0]].inputs)
+    return [c for c in nl.topo_cells() if c.id in need]
+
+
+def encode_ternary(cells: list[CellInst], cnf: Cnf,
+                   inputs: dict[str, tuple[int, int]]) -> dict[str, tuple[int, int]]:
+    """Every net of ``cells`` as a dual-rail pair of literals (can be 0, can be 1)."""
+    nets = dict(inputs)
+    cache: dict = {}
+    for cell in cells:
+        ins = [nets[n] for n in cell.inputs]
+        lo, hi = [a for a, _ in ins], [b for _, b in ins]
+        t = cell.type
+        if t in ("AND", "NAND"):
+            out = (cnf.or_(lo), cnf.and_(hi))
+        elif t in ("OR", "NOR"):
+            out = (cnf.and_(lo), cnf.or_(hi))
+        elif t == "NOT":
+            out = (ins[0][1], ins[0][0])
+        elif t == "AMPLIFIER":
+            out = ins[0]
+        elif len(ins) <= TABLE_MAX_INPUTS:
+            values = cell_table(cell, cache)
+            k = len(ins)
+            if k == 0:
+                out = (-cnf.true, cnf.true) if values[0] else (cnf.true, -cnf.true)
+            else:
+                rows = {0: [], 1: []}
+                for r, v in enumerate(values):
+                    rows[int(v)].append(cnf.and_([hi[i] if (r >> (k - 1 - i)) & 1 else lo[i]
+                                                  for i in range(k)]))
+                out = (cnf.or_(rows[0]), cnf.or_(rows[1]))
+        else:
+            raise NotEncodable(f"cell {cell.id} ({t}, {len(ins)} inputs) has no CNF form "
+                               f"beyond {TABLE_MAX_INPUTS} inputs")
+        if t in ("NAND", "NOR"):
+            out = (out[1], out[0])
+        for net in cell.outputs:
+            nets[net] = out
+    return nets
+
+
+class HazardFinder:
+    """The static hazards of one output of ``nl``, found one at a time by a SAT solver."""
+
+    def __init__(self, nl: Netlist, output: str):
+        # python-sat's solvers are compiled extensions: loaded when a check needs them
+        from pysat.solvers import Solver
+
+        self.output = output
+        self.n = n = len(nl.inputs)
+        cells = cone_cells(nl, nl.outputs[output])
+        cnf = Cnf()
+        self.x = x = [cnf.new() for _ in range(n)]
+        self.s = s = [cnf.new() for _ in range(n)]
+        cnf.clauses.append(list(s))  # one input moves ...
+        cnf.clauses += [[-s[i], -s[j]] for i in range(n) for j in range(i + 1, n)]  # ... one
+        cnf.clauses += [[-s[k], -x[k]] for k in range(n)]  # it starts at 0
+        up = [cnf.or_([x[k], s[k]]) for k in range(n)]  # the far end of the change
+        names = list(nl.inputs)
+        net = nl.outputs[output]
+        a = encode_netlist(nl, cnf, dict(zip(names, x)), cells)[net]
+        b = encode_netlist(nl, cnf, dict(zip(names, up)), cells)[net]
+        tern = encode_ternary(cells, cnf, {nm: (cnf.or_([-x[k], s[k]]), up[k])
+                                           for k, nm in enumerate(names)})
+        lo, hi = tern[net]
+        self.a = a
+        self.hazard = cnf.and_([lo, hi, -cnf.xor2(a, b)])
+        self.solver = Solver(name=SOLVER, bootstrap_with=cnf.clauses)
+
+    def next(self) -> Change | None:
+        """A static hazard not yet excluded, or None: the output has no other."""
+        if not self.solver.solve(assumptions=[self.hazard]):
+            return None
+        model = set(lit for lit in self.solver.get_model() if lit > 0)
+        k = next(i for i in range(self.n) if self.s[i] in model)
+        start = sum(1 << (self.n - 1 - i) for i in range(self.n) if self.x[i] in model)
+        return Change(self.output, k, start, int(self.a in model))
+
+    def exclude(self, ch: Change) -> None:
+        """Ask for other changes than ``ch`` from now on."""
+        self.solver.add_clause([-self.s[ch.moving]] + [
+            -self.x[i] if (ch.start >> (self.n - 1 - i)) & 1 else self.x[i]
+            for i in range(self.n) if i != ch.moving])
+
+    def exclude_cube(self, cube: list[tuple[int, int]]) -> None:
+        """Ask only for changes outside ``cube`` (literals (input, value)): a change lies inside
+        it when its start satisfies every literal and its moving input is not one of them."""
+        self.solver.add_clause([lit for i, v in cube
+                                for lit in ((-self.x[i] if v else self.x[i]), self.s[i])])
+
+    def close(self) -> None:
+        self.solver.delete()
+
+
+def sat_hazards(nl: Netlist, outputs: list[str] | None = None) -> dict[str, Change]:
+    """Output -> one static hazard (a witness), for every output that has any (SAT: a proof
+    over every vector and single-input change that the others have none)."""
+    found: dict[str, Change] = {}
+    for o in outputs if outputs is not None else list(nl.outputs):
+        if nl.outputs[o] in nl.inputs:
+            continue
+        f = HazardFinder(nl, o)
+        try:
+            ch = f.next()
+        finally:
+            f.close()
+        if ch is not None:
+            found[o] = ch
+    return found
+
+
+def all_hazards(nl: Netlist, output: str, limit: int = 1 << 20) -> list[Change]:
+    """Every static hazard of one output (up to ``limit``), each a distinct change: what the
+    enumeration finds, by SAT (the tests compare the two)."""
+    f = HazardFinder(nl, output)
+    out: list[Change] = []
+    try:
+        while len(out) < limit:
+            ch = f.next()
+            if ch is None:
+                break
+            out.append(ch)
+            f.exclude(ch)
+    finally:
+        f.close()
+    return out
+
+
+class Implicants:
+    """Whether a cube is an implicant of one output of ``nl`` (or of its complement), by SAT on
+    the output's cone."""
+
+    def __init__(self, nl: Netlist, output: str):
+        from pysat.solvers import Solver  # compiled extension, loaded on use
+
+        self.n = len(nl.inputs)
+        cnf = Cnf()
+        self.x = [cnf.new() for _ in range(self.n)]
+        net = nl.outputs[output]
+        self.y = encode_netlist(nl, cnf, dict(zip(nl.inputs, self.x)), cone_cells(nl, net))[net]
+        self.solver = Solver(name=SOLVER, bootstrap_with=cnf.clauses)
+
+    def holds(self, cube: list[tuple[int, int]], value: int) -> bool:
+        """Whether the output is ``value`` at every point of ``cube``."""
+        lits = [self.x[i] if v else -self.x[i] for i, v in cube]
+        return not self.solver.solve(assumptions=lits + [-self.y if value else self.y])
+
+    def close(self) -> None:
+        self.solver.delete()
+
+
+def prime_around(imp: Implicants, ch: Change) -> list[tuple[int, int]]:
+    """A prime implicant of the output (of its complement for a static-0 change) containing
+    both ends of ``ch`` with the moving input free: the change's start without the moving
+    input, then each literal dropped in turn while the cube stays an implicant."""
+    n = imp.n
+    cube = [(i, (ch.start >> (n - 1 - i)) & 1) for i in range(n) if i != ch.moving]
+    for lit in list(cube):
+        trial = [c for c in cube if c != lit]
+        if imp.holds(trial, ch.value):
+            cube = trial
+    return cube
