@@ -107,12 +107,13 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
 
 #: The equation text of an output built from the spec's network with no sum of products.
 NO_EQUATIONS = "the spec's network (multi-level, no sum of products)"
-#: Structural specs (BLIF, Verilog) with at most this many inputs would still get the
-#: two-level minimise before ``--levels multi``, its hazard-free covers a candidate and a hazard
-#: fallback. None does: measured, the designs are the same without it (8-bit adder 546 parts,
-#: 8-bit comparator 446, ALU 8420 either way) and the minimise was most of the time (adder
-#: 33.6 s of 45.5 s, ALU 8.5 s of 84 s).
-MINIMISE_BEFORE_MULTI_MAX_INPUTS = 0
+#: Structural specs (BLIF, Verilog) with at most this many inputs (those with a truth table)
+#: still get the two-level minimise before ``--levels multi``: its hazard-free covers,
+#: factored, are a candidate and a hazard fallback. Measured without it: the same designs for
+#: the 8-bit adder (546 parts; 45.5 s -> 7.1 s), the generated 8-bit comparator (446) and the
+#: ALU (8420), but examples/multilevel/cmp8.v went from 546 parts (the factored covers won) to
+#: 772, so only wider specs, which have no table, go from the network alone.
+MINIMISE_BEFORE_MULTI_MAX_INPUTS = MAX_TABLE_INPUTS
 
 
 def network_only(spec: Spec, opts: CompileOptions) -> bool:
