@@ -173,3 +173,18 @@ def test_an_injected_error_in_a_wide_design_file_is_caught_by_sat():
     f = rep.failures[0]
     v = np.array([[f["inputs"][x]] for x in design.spec.inputs], dtype=bool)
     assert int(design.spec.values_at(v)[f["output"]][0]) == f["expected"] != f["got"]
+
+
+def test_a_hazard_no_candidate_can_cure_stops_the_compile_exit_1(cli, tmp_path, monkeypatch):
+    """Never a design with an unreported hazard: where the cure fails on every candidate of a
+    wide spec (no two-level fallback exists), the compile says which outputs, exit 1."""
+    import mechc.passes.multilevel as ml
+
+    monkeypatch.setattr(ml, "static_hazards", lambda nl, *a, **k: {"CO": 1})
+    monkeypatch.setattr(ml, "cure_hazards", lambda *a, **k: None)
+    spec = tmp_path / "wide.blif"
+    spec.write_text(adder_blif(11))
+    code, _, err = cli("compile", spec, "-o", tmp_path / "w.json")
+    assert code == 1, err
+    assert "no hazard-free network" in err and "CO" in err and "Traceback" not in err
+    assert not (tmp_path / "w.json").exists()
