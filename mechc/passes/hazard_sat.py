@@ -41,10 +41,10 @@ class Change:
     value: int
 
 
-def cone_cells(nl: Netlist, net: str) -> list[CellInst]:
-    """The cells ``net`` depends on, in the netlist's topological order."""
+def cone_cells(nl: Netlist, *nets: str) -> list[CellInst]:
+    """The cells the ``nets`` depend on, in the netlist's topological order."""
     need: set[str] = set()
-    todo = [net]
+    todo = list(nets)
     while todo:
         x = todo.pop()
         drv = nl.driver.get(x)
@@ -94,15 +94,18 @@ def encode_ternary(cells: list[CellInst], cnf: Cnf,
 
 
 class HazardFinder:
-    """The static hazards of one output of ``nl``, found one at a time by a SAT solver."""
+    """The static hazards of some outputs of ``nl`` (one, by default every one), found one at a
+    time by a SAT solver over the union of their cones."""
 
-    def __init__(self, nl: Netlist, output: str):
+    def __init__(self, nl: Netlist, output: str | list[str]):
         # python-sat's solvers are compiled extensions: loaded when a check needs them
         from pysat.solvers import Solver
 
-        self.output = output
+        outs = [output] if isinstance(output, str) else list(output)
+        self.output = outs[0]
         self.n = n = len(nl.inputs)
-        cells = cone_cells(nl, nl.outputs[output])
+        nets = [nl.outputs[o] for o in outs]
+        cells = cone_cells(nl, *nets)
         cnf = Cnf()
         self.x = x = [cnf.new() for _ in range(n)]
         self.s = s = [cnf.new() for _ in range(n)]
@@ -111,24 +114,30 @@ class HazardFinder:
         cnf.clauses += [[-s[k], -x[k]] for k in range(n)]  # it starts at 0
         up = [cnf.or_([x[k], s[k]]) for k in range(n)]  # the far end of the change
         names = list(nl.inputs)
-        net = nl.outputs[output]
-        a = encode_netlist(nl, cnf, dict(zip(names, x)), cells)[net]
-        b = encode_netlist(nl, cnf, dict(zip(names, up)), cells)[net]
+        a = encode_netlist(nl, cnf, dict(zip(names, x)), cells)
+        b = encode_netlist(nl, cnf, dict(zip(names, up)), cells)
         tern = encode_ternary(cells, cnf, {nm: (cnf.or_([-x[k], s[k]]), up[k])
                                            for k, nm in enumerate(names)})
-        lo, hi = tern[net]
-        self.a = a
-        self.hazard = cnf.and_([lo, hi, -cnf.xor2(a, b)])
+        self.a = {o: a[net] for o, net in zip(outs, nets)}
+        self.hazards = {o: cnf.and_([*tern[net], -cnf.xor2(a[net], b[net])])
+                        for o, net in zip(outs, nets)}
+        self.any = cnf.or_(list(self.hazards.values()))
         self.solver = Solver(name=SOLVER, bootstrap_with=cnf.clauses)
 
-    def next(self) -> Change | None:
-        """A static hazard not yet excluded, or None: the output has no other."""
-        if not self.solver.solve(assumptions=[self.hazard]):
+    def next(self, output: str | None = None) -> Change | None:
+        """A static hazard of ``output`` (default: the first output) not yet excluded, or
+        None: that output has no other."""
+        o = output or self.output
+        if not self.solver.solve(assumptions=[self.hazards[o]]):
             return None
         model = set(lit for lit in self.solver.get_model() if lit > 0)
         k = next(i for i in range(self.n) if self.s[i] in model)
         start = sum(1 << (self.n - 1 - i) for i in range(self.n) if self.x[i] in model)
-        return Change(self.output, k, start, int(self.a in model))
+        return Change(o, k, start, int(self.a[o] in model))
+
+    def none_at_all(self) -> bool:
+        """Whether no output has any static hazard (one solver call for all of them)."""
+        return not self.solver.solve(assumptions=[self.any])
 
     def exclude(self, ch: Change) -> None:
         """Ask for other changes than ``ch`` from now on."""
@@ -150,16 +159,20 @@ def sat_hazards(nl: Netlist, outputs: list[str] | None = None) -> dict[str, Chan
     """Output -> one static hazard (a witness), for every output that has any (SAT: a proof
     over every vector and single-input change that the others have none)."""
     found: dict[str, Change] = {}
-    for o in outputs if outputs is not None else list(nl.outputs):
-        if nl.outputs[o] in nl.inputs:
-            continue
-        f = HazardFinder(nl, o)
-        try:
-            ch = f.next()
-        finally:
-            f.close()
-        if ch is not None:
-            found[o] = ch
+    outs = [o for o in (outputs if outputs is not None else list(nl.outputs))
+            if nl.outputs[o] not in nl.inputs]
+    if not outs:
+        return found
+    f = HazardFinder(nl, outs)
+    try:
+        if f.none_at_all():  # the usual answer for a good candidate: one call proves it
+            return found
+        for o in outs:
+            ch = f.next(o)
+            if ch is not None:
+                found[o] = ch
+    finally:
+        f.close()
     return found
 
 
