@@ -17,6 +17,7 @@ from mechc.cells.library import load_library
 from mechc.frontends import load_spec
 from mechc.frontends.blif import parse_blif
 from mechc.frontends.spec_json import spec_from_json
+from mechc.frontends.verilog import parse_verilog
 from mechc.passes.map_sop import MapOptions
 from mechc.passes.minimise import MinimiseOptions
 from mechc.passes.multilevel import map_multilevel_hazard_free
@@ -86,6 +87,24 @@ def test_wide_verilog_is_valued_by_its_network():
     for o in spec.outputs:
         assert np.array_equal(got[o], want[o]), o
     assert spec.display["A3"] == "A[3]"
+
+
+def test_wide_behavioural_verilog_compares_as_integers():
+    """``a > b`` and ``a == b`` on 12-bit ports (24 inputs), elaborated by Yosys and valued by
+    its gate network, against Python's integer comparison."""
+    text = ("module cmp(input [11:0] a, input [11:0] b, output gt, output eq);\n"
+            "  assign gt = a > b;\n  assign eq = a == b;\nendmodule\n")
+    spec = parse_verilog(text, "cmp.v")
+    assert spec.n == 24 and spec.network is not None
+    bits = random_bits(24, 4096, 7)
+    bits[12:, :1024] = bits[:12, :1024]  # a == b on a quarter of the vectors
+    col = {nm: bits[k].astype(np.int64) for k, nm in enumerate(spec.inputs)}
+    a = sum(col[f"a{i}"] << i for i in range(12))
+    b = sum(col[f"b{i}"] << i for i in range(12))
+    got = spec.values_at(bits)
+    assert np.array_equal(got["gt"], (a > b).astype(np.int8))
+    assert np.array_equal(got["eq"], (a == b).astype(np.int8))
+    assert got["eq"].sum() >= 1024
 
 
 def test_the_network_echo_reads_back_to_the_same_function():
