@@ -191,9 +191,7 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
     if opts.levels == "2":
         return nl, layout, mech, amps, kept, {}
     if mapped is None:
-        return nl, layout, mech, amps, kept, {"asked": opts.levels, "chosen": chosen,
-                                               "parts": {k: parts[k] for k in sorted(parts)},
-                                               "two_level": "not built", "multi": info}
+        two_level = "not built"  # a spec with no table: multi-level is the one way
     return nl, layout, mech, amps, kept, {"asked": opts.levels, "chosen": chosen,
                                            "parts": {k: parts[k] for k in sorted(parts)},
                                            "two_level": two_level, "multi": info}
@@ -342,12 +340,10 @@ def design_stats(eq: Equations | None, nl: Netlist, lib: Library,
     parts = sum(lib[c.cell].cost(len(c.inputs)) for c in nl.cells.values())
     if eq is None:  # built from the spec's network: no sums of products to count
         return {"cells": len(nl.cells), "cells_by_type": nl.count_by_type(), "parts": parts,
-                "literals": None,
-                "depth": max(nl.depth().values(), default=0),
+                "literals": None, "depth": max(nl.depth().values(), default=0),
                 "crossings": layout.crossings if layout else None,
                 "minimisation": {"skipped": "multi-level synthesis from the spec's network",
-                                 "proven": False, "time_limited": [],
-                                 "outputs": {}}}
+                                 "proven": False, "time_limited": [], "outputs": {}}}
     per_output = {
         o: {"terms": c.terms, "literals": c.literals, "proven": c.proven, "method": c.method}
         for o, c in eq.covers.items()
