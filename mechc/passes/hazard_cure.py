@@ -31,7 +31,7 @@ from mechc.cells.library import Library
 from mechc.ir.netlist import Netlist
 from mechc.logic.cubes import Cube, input_matrix
 from mechc.passes.factor import factored_sum
-from mechc.passes.hazard_sat import HazardFinder, Implicants, prime_around
+from mechc.passes.hazard_sat import Implicants, MovingInput, prime_around
 from mechc.passes.map_sop import Key, MapOptions, Planner, _materialise
 from mechc.passes.ternary import MAX_EXHAUSTIVE_INPUTS, hazard_transitions
 
@@ -152,18 +152,23 @@ def sat_cubes(nl: Netlist, output: str) -> dict[int, list[list[tuple[int, int]]]
     complement for a static-0 change) around it, exclude the changes that cube holds, repeat
     until the solver finds none. Value (0 or 1) -> cubes as literals (input, value); None past
     :data:`MAX_SAT_CUBES` cubes."""
-    finder = HazardFinder(nl, output)
     imp = Implicants(nl, output)
     cubes: dict[int, list[list[tuple[int, int]]]] = {0: [], 1: []}
     try:
-        while (ch := finder.next()) is not None:
-            if len(cubes[0]) + len(cubes[1]) >= MAX_SAT_CUBES:
-                return None
-            cube = prime_around(imp, ch)
-            cubes[ch.value].append(cube)
-            finder.exclude_cube(cube)
+        for k in range(len(nl.inputs)):
+            finder = MovingInput(nl, k, [output])
+            try:
+                for cube in cubes[0] + cubes[1]:
+                    finder.exclude_cube(cube)
+                while (ch := finder.next(output)) is not None:
+                    if len(cubes[0]) + len(cubes[1]) >= MAX_SAT_CUBES:
+                        return None
+                    cube = prime_around(imp, ch)
+                    cubes[ch.value].append(cube)
+                    finder.exclude_cube(cube)
+            finally:
+                finder.close()
     finally:
-        finder.close()
         imp.close()
     return cubes
 

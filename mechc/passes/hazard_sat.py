@@ -93,103 +93,123 @@ def encode_ternary(cells: list[CellInst], cnf: Cnf,
     return nets
 
 
-class HazardFinder:
-    """The static hazards of some outputs of ``nl`` (one, by default every one), found one at a
-    time by a SAT solver over the union of their cones."""
+def fanout_cells(cells: list[CellInst], net: str) -> list[CellInst]:
+    """The cells of ``cells`` (topologically ordered) that ``net`` reaches."""
+    reached = {net}
+    out = []
+    for c in cells:
+        if any(i in reached for i in c.inputs):
+            out.append(c)
+            reached.update(c.outputs)
+    return out
 
-    def __init__(self, nl: Netlist, output: str | list[str]):
+
+class MovingInput:
+    """The static hazards of some outputs of ``nl`` on the changes of one input ``k``, found one
+    at a time by a SAT solver. Outside the moving input's fan-out the two ends and the
+    dual-rail copy share the binary copy's literals (they are equal there), so each copy adds
+    only that fan-out: the solver never has to rediscover that two copies of a carry chain
+    agree."""
+
+    def __init__(self, nl: Netlist, k: int, outputs: list[str]):
         # python-sat's solvers are compiled extensions: loaded when a check needs them
         from pysat.solvers import Solver
 
-        outs = [output] if isinstance(output, str) else list(output)
-        self.output = outs[0]
         self.n = n = len(nl.inputs)
-        nets = [nl.outputs[o] for o in outs]
-        cells = cone_cells(nl, *nets)
-        cnf = Cnf()
-        self.x = x = [cnf.new() for _ in range(n)]
-        self.s = s = [cnf.new() for _ in range(n)]
-        cnf.clauses.append(list(s))  # one input moves ...
-        cnf.clauses += [[-s[i], -s[j]] for i in range(n) for j in range(i + 1, n)]  # ... one
-        cnf.clauses += [[-s[k], -x[k]] for k in range(n)]  # it starts at 0
-        up = [cnf.or_([x[k], s[k]]) for k in range(n)]  # the far end of the change
+        self.k = k
         names = list(nl.inputs)
+        nets = {o: nl.outputs[o] for o in outputs}
+        cells = cone_cells(nl, *nets.values())
+        moved = fanout_cells(cells, names[k])
+        cnf = Cnf()
+        self.x = x = [cnf.new() if i != k else -cnf.true for i in range(n)]
         a = encode_netlist(nl, cnf, dict(zip(names, x)), cells)
-        b = encode_netlist(nl, cnf, dict(zip(names, up)), cells)
-        tern = encode_ternary(cells, cnf, {nm: (cnf.or_([-x[k], s[k]]), up[k])
-                                           for k, nm in enumerate(names)})
-        self.a = {o: a[net] for o, net in zip(outs, nets)}
+        b = encode_netlist(nl, cnf, {**a, names[k]: cnf.true}, moved)
+        t0 = {net: (-lit, lit) for net, lit in a.items()}
+        t0[names[k]] = (cnf.true, cnf.true)
+        tern = encode_ternary(moved, cnf, t0)
+        reach = {names[k]} | {net for c in moved for net in c.outputs}
+        self.a = {o: a[net] for o, net in nets.items()}
         self.hazards = {o: cnf.and_([*tern[net], -cnf.xor2(a[net], b[net])])
-                        for o, net in zip(outs, nets)}
-        self.any = cnf.or_(list(self.hazards.values()))
+                        for o, net in nets.items() if net in reach}
+        self.top = cnf.top
         self.solver = Solver(name=SOLVER, bootstrap_with=cnf.clauses)
 
-    def next(self, output: str | None = None) -> Change | None:
-        """A static hazard of ``output`` (default: the first output) not yet excluded, or
-        None: that output has no other."""
-        o = output or self.output
-        if not self.solver.solve(assumptions=[self.hazards[o]]):
+    def next(self, output: str | list[str] | None = None) -> Change | None:
+        """A static hazard of ``output`` (of any of a list, default: of any output) not yet
+        excluded, or None: none of them has one on this input's changes."""
+        outs = ([output] if isinstance(output, str) else
+                list(self.hazards) if output is None else list(output))
+        outs = [o for o in outs if o in self.hazards]
+        if not outs:
+            return None
+        if len(outs) == 1:
+            goal = self.hazards[outs[0]]
+        else:  # a fresh literal that implies one of their hazards, assumed for this call
+            self.top += 1
+            goal = self.top
+            self.solver.add_clause([-goal] + [self.hazards[o] for o in outs])
+        if not self.solver.solve(assumptions=[goal]):
             return None
         model = set(lit for lit in self.solver.get_model() if lit > 0)
-        k = next(i for i in range(self.n) if self.s[i] in model)
-        start = sum(1 << (self.n - 1 - i) for i in range(self.n) if self.x[i] in model)
-        return Change(o, k, start, int(self.a[o] in model))
-
-    def none_at_all(self) -> bool:
-        """Whether no output has any static hazard (one solver call for all of them)."""
-        return not self.solver.solve(assumptions=[self.any])
+        start = sum(1 << (self.n - 1 - i) for i in range(self.n)
+                    if i != self.k and self.x[i] in model)
+        o = next(o for o in outs if self.hazards[o] in model)
+        return Change(o, self.k, start, int(self.a[o] in model))
 
     def exclude(self, ch: Change) -> None:
         """Ask for other changes than ``ch`` from now on."""
-        self.solver.add_clause([-self.s[ch.moving]] + [
-            -self.x[i] if (ch.start >> (self.n - 1 - i)) & 1 else self.x[i]
-            for i in range(self.n) if i != ch.moving])
+        self.solver.add_clause([-self.x[i] if (ch.start >> (self.n - 1 - i)) & 1 else self.x[i]
+                                for i in range(self.n) if i != self.k])
 
     def exclude_cube(self, cube: list[tuple[int, int]]) -> None:
-        """Ask only for changes outside ``cube`` (literals (input, value)): a change lies inside
-        it when its start satisfies every literal and its moving input is not one of them."""
-        self.solver.add_clause([lit for i, v in cube
-                                for lit in ((-self.x[i] if v else self.x[i]), self.s[i])])
+        """Ask only for changes outside ``cube`` (literals (input, value)); a cube with a literal
+        of the moving input holds none of its changes."""
+        if all(i != self.k for i, _ in cube):
+            self.solver.add_clause([-self.x[i] if v else self.x[i] for i, v in cube])
 
     def close(self) -> None:
         self.solver.delete()
+
+
+def _outputs(nl: Netlist, outputs: list[str] | None) -> list[str]:
+    """The named outputs (default all) that a cell drives (an input passed through has no
+    hazard)."""
+    return [o for o in (outputs if outputs is not None else list(nl.outputs))
+            if nl.outputs[o] not in nl.inputs]
 
 
 def sat_hazards(nl: Netlist, outputs: list[str] | None = None) -> dict[str, Change]:
     """Output -> one static hazard (a witness), for every output that has any (SAT: a proof
     over every vector and single-input change that the others have none)."""
     found: dict[str, Change] = {}
-    outs = [o for o in (outputs if outputs is not None else list(nl.outputs))
-            if nl.outputs[o] not in nl.inputs]
-    if not outs:
-        return found
-    f = HazardFinder(nl, outs)
-    try:
-        if f.none_at_all():  # the usual answer for a good candidate: one call proves it
-            return found
-        for o in outs:
-            ch = f.next(o)
-            if ch is not None:
-                found[o] = ch
-    finally:
-        f.close()
+    outs = _outputs(nl, outputs)
+    for k in range(len(nl.inputs)):
+        todo = [o for o in outs if o not in found]
+        if not todo:
+            break
+        f = MovingInput(nl, k, todo)
+        try:
+            while (ch := f.next(todo)) is not None:  # one call proves "none" for them all
+                found[ch.output] = ch
+                todo.remove(ch.output)
+        finally:
+            f.close()
     return found
 
 
 def all_hazards(nl: Netlist, output: str, limit: int = 1 << 20) -> list[Change]:
     """Every static hazard of one output (up to ``limit``), each a distinct change: what the
     enumeration finds, by SAT (the tests compare the two)."""
-    f = HazardFinder(nl, output)
     out: list[Change] = []
-    try:
-        while len(out) < limit:
-            ch = f.next()
-            if ch is None:
-                break
-            out.append(ch)
-            f.exclude(ch)
-    finally:
-        f.close()
+    for k in range(len(nl.inputs)):
+        f = MovingInput(nl, k, _outputs(nl, [output]))
+        try:
+            while len(out) < limit and (ch := f.next(output)) is not None:
+                out.append(ch)
+                f.exclude(ch)
+        finally:
+            f.close()
     return out
 
 
