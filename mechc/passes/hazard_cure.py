@@ -147,11 +147,11 @@ def cure_hazards(nl: Netlist, outputs: list[str], library: Library,
 
 
 def sat_cubes(nl: Netlist, output: str) -> dict[int, list[list[tuple[int, int]]]] | None:
-    """The cubes that cure one output's static hazards, found by SAT with no enumeration:
-    ask for a hazardous change no cube holds yet, take a prime implicant of the output (of its
-    complement for a static-0 change) around it, exclude the changes that cube holds, repeat
-    until the solver finds none. Value (0 or 1) -> cubes as literals (input, value); None past
-    :data:`MAX_SAT_CUBES` cubes."""
+    """The cubes that cure one output's static hazards, found by SAT with no enumeration: for
+    each moving input, ask for a hazardous change no cube holds yet, take a prime implicant of
+    the output (of its complement for a static-0 change) around it, exclude the changes that
+    cube holds, repeat until the solver finds none. Value (0 or 1) -> cubes as literals
+    (input, value); None past :data:`MAX_SAT_CUBES` cubes."""
     imp = Implicants(nl, output)
     cubes: dict[int, list[list[tuple[int, int]]]] = {0: [], 1: []}
     try:

@@ -2,20 +2,24 @@
 
 The ternary check (:mod:`mechc.passes.ternary`) simulates every input vector and every
 single-input change: 2**n * n of them. Here the same question is put to a SAT solver, once per
-output, with no enumeration. The output's cone is written three times over shared input
-variables ``x`` (the start of the change) and one-hot selectors ``s`` (which input moves):
+input ``k`` (:class:`MovingInput`), with no enumeration. The outputs' cones are written over
+variables ``x`` for the other inputs (the start of the change, input ``k`` at 0):
 
-- a binary copy at ``x`` (the moving input at 0) and one at ``x`` with the moving input at 1;
-- a dual-rail (ternary) copy, each net a pair (can be 0, can be 1): every input is its binary
-  value except the moving one, which can be both (X); each cell's pair is exact for its
-  ternary extension (a row of its table is possible where every input can take that row's
-  value), the same rule :func:`mechc.ir.ternary.evaluate3` simulates.
+- a binary copy at ``x``, and a second one with input ``k`` at 1;
+- a dual-rail (ternary) copy, each net a pair (can be 0, can be 1): input ``k`` can be both
+  (X), every other input is its binary value, and each cell's pair is exact for its ternary
+  extension (a row of its table is possible where every input can take that row's value), the
+  rule :func:`mechc.ir.ternary.evaluate3` simulates.
 
-A model of "output X in the ternary copy, equal in both binary copies" is a static hazard of
-that output on that change; none is a proof, over all 2**n * n changes, that the output has
-no static hazard. The cure (:mod:`mechc.passes.hazard_cure`) asks for hazards one at a time and
-excludes those the cubes chosen so far already hold (:meth:`HazardFinder.exclude_cube`), so it
-never lists them all.
+Only the fan-out of input ``k`` differs between the copies; outside it the second end and the
+dual-rail copy reuse the first copy's literals, so the solver never has to rediscover that two
+copies of a carry chain agree (written with a free one-hot choice of the moving input instead,
+the 32-bit adder's check did not finish in minutes). A model of "output X in the dual-rail
+copy, equal in both binary copies" is a static hazard of that output on a change of ``k``;
+none, for every ``k``, is a proof over all 2**n * n changes that the output has no static
+hazard. The cure (:mod:`mechc.passes.hazard_cure`) asks for hazards one at a time and excludes
+those the cubes chosen so far already hold (:meth:`MovingInput.exclude_cube`), so it never
+lists them all.
 """
 
 from __future__ import annotations
