@@ -21,7 +21,7 @@ from mechc.logic.cubes import input_matrix
 from mechc.passes.hazard_sat import sat_hazards
 
 #: The most inputs :func:`hazard_transitions` enumerates (2^n * n changes); beyond, it takes a
-#: seeded sample of vectors (the screened proof's use; the hazard check itself goes to SAT).
+#: seeded sample of vectors (never used for a verdict: the hazard check goes to SAT there).
 MAX_EXHAUSTIVE_INPUTS = 16
 SAMPLE_VECTORS = 1 << 14
 #: From this many inputs :func:`static_hazards` asks SAT instead of enumerating (measured on
