@@ -207,3 +207,16 @@ def test_a_hazard_no_candidate_can_cure_stops_the_compile_exit_1(cli, tmp_path, 
     assert code == 1, err
     assert "no hazard-free network" in err and "CO" in err and "Traceback" not in err
     assert not (tmp_path / "w.json").exists()
+
+
+def test_the_dynamic_proofs_plan_of_a_wide_design_is_a_walk_not_a_tour():
+    """33 inputs: the plan is a seeded random walk of single-input changes (the Gray tour of
+    2^33 vectors was once built before that choice, and the process ran out of memory)."""
+    from mechc.proofs.dynamic import plan
+
+    walk = plan(33, 16, 0)
+    assert len(walk) == 64
+    prev = 0
+    for v in walk:
+        assert 0 <= v < 1 << 33 and bin(v ^ prev).count("1") == 1  # one input at a time
+        prev = v
