@@ -14,13 +14,14 @@ from dataclasses import dataclass, field
 
 from mechc.cells.library import Library, load_library
 from mechc.cells.sources import cell_sources
-from mechc.errors import MechcError
+from mechc.errors import MechcError, UsageError
 from mechc.ir.design import Design
 from mechc.ir.equations import Equations
 from mechc.ir.layout import Layout
 from mechc.ir.mechanism import Mechanism
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import Spec
+from mechc.logic.cubes import MAX_TABLE_INPUTS
 from mechc.passes.amplify import (
     amplify_nets,
     nets_overstressed,
@@ -80,10 +81,13 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
 
     if getattr(spec, "kind", "") == "fsm":
         return compile_sequential(spec, opts, lib, stage=stage, seconds=seconds)
-    eq = stage("minimise", minimise, spec, opts.minimise)
-    mapped = stage("map", map_equations, eq, lib, opts.map)
-    if getattr(mapped, "equations", None) is not None:
-        eq = mapped.equations  # the mapper built the alternative covers (fewer parts)
+    if network_only(spec, opts):  # multi-level from the network: no table, no minimise
+        eq, mapped = None, None
+    else:
+        eq = stage("minimise", minimise, spec, opts.minimise)
+        mapped = stage("map", map_equations, eq, lib, opts.map)
+        if getattr(mapped, "equations", None) is not None:
+            eq = mapped.equations  # the mapper built the alternative covers (fewer parts)
     nl, layout, mech, amps, mapped, levels = build_levels(spec, eq, mapped, lib, opts, stage)
     stats = design_stats(eq, nl, lib, layout)
     if levels:
@@ -93,11 +97,39 @@ def compile_spec(spec: Spec, opts: CompileOptions | None = None,
         stats["names"] = dict(spec.display)  # safe identifier -> the spec file's own name
     if amps:
         stats["amplified"] = amps
-    design = Design(spec, {o: eq.text(o) for o in spec.outputs}, mapped.implemented,
-                    nl, layout, stats, seconds, eq, mech)
+    equations = ({o: eq.text(o) for o in spec.outputs} if eq is not None else
+                 {o: NO_EQUATIONS for o in spec.outputs})
+    design = Design(spec, equations, mapped.implemented, nl, layout, stats, seconds, eq, mech)
     design.cell_sources = cell_sources(nl, lib)
     stage("check", run_design_checks, design, lib)
     return design
+
+
+#: The equation text of an output built from the spec's network with no sum of products.
+NO_EQUATIONS = "the spec's network (multi-level, no sum of products)"
+#: Structural specs (BLIF, Verilog) with at most this many inputs (those with a truth table)
+#: still get the two-level minimise before ``--levels multi``: its hazard-free covers,
+#: factored, are a candidate and a hazard fallback. Measured without it: the same designs for
+#: the 8-bit adder (546 parts; 45.5 s -> 7.1 s), the generated 8-bit comparator (446) and the
+#: ALU (8420), but examples/multilevel/cmp8.v went from 546 parts (the factored covers won) to
+#: 772, so only wider specs, which have no table, go from the network alone.
+MINIMISE_BEFORE_MULTI_MAX_INPUTS = MAX_TABLE_INPUTS
+
+
+def network_only(spec: Spec, opts: CompileOptions) -> bool:
+    """Whether multi-level synthesis starts from the spec's network alone (no minimise, no
+    two-level map). A network-valued spec has no table to minimise, so two levels cannot be
+    built for it: asked for, that is an error naming the file (exit 2)."""
+    if spec.network is not None:
+        if opts.levels == "2" or opts.map.target != "conventional":
+            what = ("--levels 2" if opts.levels == "2"
+                    else f"--map {opts.map.target} (two-level only)")
+            raise UsageError(f"{spec.path}: {spec.n} inputs is more than a truth table takes "
+                             f"({MAX_TABLE_INPUTS}), so {what} cannot be built: the design "
+                             "is synthesised multi-level from its network (--levels multi)")
+        return True
+    return (bool(spec.structure) and opts.levels == "multi"
+            and spec.n > MINIMISE_BEFORE_MULTI_MAX_INPUTS)
 
 
 def netlist_parts(nl: Netlist, lib: Library) -> int:
@@ -118,6 +150,8 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
     levels = opts.levels
     if levels not in ("2", "multi", "auto"):
         raise ValueError(f"levels must be 2, multi or auto, not {levels!r}")
+    if mapped is None:  # network only (network_only): multi-level is the one way to build it
+        levels = "multi"
     if opts.map.target != "conventional" and levels == "auto":
         levels = "2"  # threshold mapping is two-level; multi-level maps to AND/OR-family cells
     built: dict[str, tuple] = {}
@@ -128,8 +162,8 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
         blif = spec.structure or equations_blif(eq)
         try:
             ml = stage("multi-level", map_multilevel_hazard_free, blif, list(spec.inputs),
-                       list(spec.outputs), lib, opts.map, opts.minimise, mapped.netlist,
-                       opts.map.fan_in, eq)
+                       list(spec.outputs), lib, opts.map, opts.minimise,
+                       mapped.netlist if mapped is not None else None, opts.map.fan_in, eq)
         except MechcError as e:
             if levels == "multi":
                 raise
@@ -142,7 +176,7 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
                 "tried": ml.tried, "two_level_outputs": ml.two_level_outputs,
                 "cured_outputs": ml.cured_outputs}
     parts = {k: netlist_parts(v[0], lib) for k, v in built.items()}
-    two_mapped = netlist_parts(mapped.netlist, lib)
+    two_mapped = netlist_parts(mapped.netlist, lib) if mapped is not None else 0
     two_level = "assembled"
     if levels == "auto" and "multi" in parts and parts["multi"] < two_mapped:
         two_level = "mapped only: its parts before amplifiers, a lower bound"
@@ -156,6 +190,8 @@ def build_levels(spec: Spec, eq: Equations, mapped, lib: Library, opts: CompileO
     nl, layout, mech, amps, kept = built[chosen]
     if opts.levels == "2":
         return nl, layout, mech, amps, kept, {}
+    if mapped is None:
+        two_level = "not built"  # a spec with no table: multi-level is the one way
     return nl, layout, mech, amps, kept, {"asked": opts.levels, "chosen": chosen,
                                            "parts": {k: parts[k] for k in sorted(parts)},
                                            "two_level": two_level, "multi": info}
@@ -299,8 +335,15 @@ def compile_netlist(spec: Spec, netlist: Netlist, opts: CompileOptions | None = 
     return design
 
 
-def design_stats(eq: Equations, nl: Netlist, lib: Library, layout: Layout | None) -> dict:
+def design_stats(eq: Equations | None, nl: Netlist, lib: Library,
+                 layout: Layout | None) -> dict:
     parts = sum(lib[c.cell].cost(len(c.inputs)) for c in nl.cells.values())
+    if eq is None:  # built from the spec's network: no sums of products to count
+        return {"cells": len(nl.cells), "cells_by_type": nl.count_by_type(), "parts": parts,
+                "literals": None, "depth": max(nl.depth().values(), default=0),
+                "crossings": layout.crossings if layout else None,
+                "minimisation": {"skipped": "multi-level synthesis from the spec's network",
+                                 "proven": False, "time_limited": [], "outputs": {}}}
     per_output = {
         o: {"terms": c.terms, "literals": c.literals, "proven": c.proven, "method": c.method}
         for o, c in eq.covers.items()

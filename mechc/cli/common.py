@@ -143,9 +143,12 @@ def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = Tru
     spec = load_spec(spec_path)
     if not mechanism and getattr(spec, "kind", "") == "fsm":
         return compile_sequential(spec, options_from_args(args), mechanism=False)
+    opts = options_from_args(args)
+    if getattr(spec, "network", None) is not None and not getattr(args, "levels", None):
+        opts.levels = "multi"  # too wide for a table: multi-level is the one way to build it
     if stages is None:
-        return compile_spec(spec, options_from_args(args))
-    return compile_spec(spec, options_from_args(args), progress=stages.start, done=stages.end)
+        return compile_spec(spec, opts)
+    return compile_spec(spec, opts, progress=stages.start, done=stages.end)
 
 
 class StageProgress:

@@ -132,7 +132,7 @@ def compile_and_write(args: argparse.Namespace, out: str, stages: StageProgress)
     write_atomic(written, design_bytes(text, written))
     stages.end("write", time.perf_counter() - t0)
     print(f"{args.spec} -> {written}: {st['cells']} cells ({by_type(st['cells_by_type'])}), "
-          f"{st['parts']} parts, {st['literals']} literals, {minimality(st)}, "
+          f"{st['parts']} parts, {literals(st)}{minimality(st)}, "
           f"{stages.total():.2f} s")
     if not args.quiet:
         for line in details(design, args):
@@ -178,7 +178,13 @@ def check_failures(dc: dict, what: str) -> None:
               file=sys.stderr)
 
 
+def literals(st: dict) -> str:
+    return "" if st.get("literals") is None else f"{st['literals']} literals, "
+
+
 def minimality(st: dict) -> str:
+    if st["minimisation"].get("skipped"):
+        return f"no two-level minimise ({st['minimisation']['skipped']})"
     methods = {v["method"] for v in st["minimisation"]["outputs"].values()}
     if st["minimisation"]["proven"]:
         return "minimum proven"

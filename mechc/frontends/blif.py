@@ -2,10 +2,12 @@
 
 A BLIF model is a network of single-output nodes, each a ``.names`` cover: lines ``CUBE 1``
 give the node's on-set, lines ``CUBE 0`` its off-set (the node is 1 outside them), no line
-at all makes it constant 0. mechc needs the function of each primary output over the primary
-inputs, so the network is evaluated on every input vector (numpy, one boolean array per node)
-and each output's truth table is written back as an irredundant cube cover: the same
-:class:`~mechc.ir.spec.Spec` a ``.pla`` gives. Sequential and hierarchical constructs
+at all makes it constant 0. Up to :data:`MAX_TABLE_INPUTS` primary inputs the network is
+evaluated on every input vector (numpy, one boolean array per node) and each output's truth
+table is written back as an irredundant cube cover: the same :class:`~mechc.ir.spec.Spec` a
+``.pla`` gives. Wider models (a 16-bit adder has 33 inputs) are valued by the network alone
+(``Spec.network``): no table is built, the proofs simulate or SAT-encode the nodes, and the
+compiler synthesises them multi-level. Sequential and hierarchical constructs
 (``.latch``, ``.subckt``, ``.gate``, ``.exdc``, ...) are refused with their line and column.
 """
 
@@ -18,11 +20,12 @@ import numpy as np
 
 from mechc.errors import SpecError
 from mechc.frontends.lexer import Word, read_text
+from mechc.ir.network import NamesNode, Network
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import MAX_TABLE_INPUTS, Cube, input_matrix
 
-#: Evaluation is over all 2**n input vectors, so the primary inputs are capped as for .bool.
-MAX_BLIF_INPUTS = MAX_TABLE_INPUTS
+#: Beyond this many primary inputs the spec is valued by its network, not a truth table.
+TABLE_MAX_BLIF_INPUTS = MAX_TABLE_INPUTS
 _NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 UNSUPPORTED = {
     ".latch": "latches (sequential BLIF; write the machine as a .fsm or .kiss2 flow table)",
@@ -54,13 +57,29 @@ def parse_blif_file(path: str) -> Spec:
 def parse_blif(text: str, path: str = "<string>") -> Spec:
     inputs, outputs, nodes = _read(text, path)
     order = _topological(nodes, inputs, outputs, path)
+    structure = network_blif(inputs, outputs, nodes, order)
+    names_in, names_out = [w.text for w in inputs], [w.text for w in outputs]
+    if len(inputs) > TABLE_MAX_BLIF_INPUTS:  # valued by the network: no 2**n anything
+        funcs = {o.text: OutputSpec(o.text, line=nodes[o.text].out.line) for o in outputs}
+        return Spec(path, "pla", names_in, names_out, funcs, structure=structure,
+                    network=network_of(inputs, outputs, nodes, order))
     tables = _evaluate(nodes, order, inputs, outputs)
     funcs = {}
     for o in outputs:
         funcs[o.text] = OutputSpec(o.text, on=table_cover(tables[o.text], len(inputs)),
                                    line=nodes[o.text].out.line)
-    return Spec(path, "pla", [w.text for w in inputs], [w.text for w in outputs], funcs,
-                structure=network_blif(inputs, outputs, nodes, order))
+    return Spec(path, "pla", names_in, names_out, funcs, structure=structure)
+
+
+def network_of(inputs: list[Word], outputs: list[Word], nodes: dict[str, Node],
+               order: list[str]) -> Network:
+    """The nodes the outputs depend on, in evaluation order, as the IR's network."""
+    needed = _cone(nodes, outputs)
+    return Network([w.text for w in inputs], [w.text for w in outputs],
+                   [NamesNode(name, tuple(f.text for f in nodes[name].fanins),
+                              tuple(nodes[name].cubes),
+                              0 if nodes[name].phase == 0 else 1)
+                    for name in order if name in needed])
 
 
 def network_blif(inputs: list[Word], outputs: list[Word], nodes: dict[str, Node],
@@ -142,10 +161,6 @@ def _read(text: str, path: str) -> tuple[list[Word], list[Word], dict[str, Node]
                 if any(v.text == w.text for v in into):
                     raise err(w, f"'{w.text}' is listed twice in '{kw}'")
                 into.append(w)
-            if len(inputs) > MAX_BLIF_INPUTS:
-                raise err(inputs[MAX_BLIF_INPUTS], f"more than {MAX_BLIF_INPUTS} inputs: mechc "
-                          f"evaluates a BLIF network on all 2^n input vectors and allows at "
-                          f"most {MAX_BLIF_INPUTS} (use a .pla for wider functions)")
         elif kw == ".names":
             if len(words) == 1:
                 raise err(head, "expected signal names after '.names' (fanins, then the "

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+from mechc.frontends.blif import parse_blif
 from mechc.frontends.boolfile import parse_expression_text
 from mechc.frontends.fsm import parse_expression
 from mechc.ir.seqspec import FlowTable, MemorySpec, SeqSpec
@@ -11,7 +12,14 @@ from mechc.logic.cubes import DC, Cube
 
 
 def spec_from_json(d: dict, where: str = "<json>") -> Spec:
-    """The ``spec`` a design JSON embeds (expressions as ``.bool`` text, cubes as strings)."""
+    """The ``spec`` a design JSON embeds (expressions as ``.bool`` text, cubes as strings,
+    or a wide spec's network as BLIF text)."""
+    if "network" in d:  # a spec too wide for a table is valued by its network
+        spec = parse_blif(d["network"], f"{where}: spec.network")
+        if spec.inputs != list(d["inputs"]) or spec.outputs != list(d["outputs"]):
+            raise ValueError("spec.network's inputs or outputs differ from the spec's")
+        spec.path, spec.kind = d.get("source", where), d.get("kind", "pla")
+        return spec
     inputs = list(d["inputs"])
     funcs = {}
     for name in d["outputs"]:

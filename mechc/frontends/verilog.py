@@ -3,7 +3,8 @@
 Yosys parses and elaborates the module (``read_verilog``, ``hierarchy -auto-top``, ``proc``,
 ``flatten``), synthesises it to simple gates and writes it as BLIF; that network is read by the
 BLIF front end, so the ``Spec`` carries both the functions (for minimisation and the proofs)
-and the gate structure (``Spec.structure``, where multi-level synthesis starts). A vector
+and the gate structure (``Spec.structure``, where multi-level synthesis starts); beyond 20
+input bits it is valued by that gate network alone (``Spec.network``), as a wide BLIF is. A vector
 port bit ``A[3]`` becomes the input ``A3`` (the Verilog name is kept for display). Errors that
 Yosys reports are given back as ``file:line:col`` of the Verilog source; flip-flops, latches
 and memories are refused at their line (sequential specs are written as .fsm or .kiss2).

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mechc.ir import expr as ex
+from mechc.ir.network import Network
 from mechc.logic.cubes import DC, MAX_TABLE_INPUTS, Cube, cube_table, input_matrix
 
 
@@ -40,6 +41,10 @@ class Spec:
     # a structural network the author gave (BLIF, Verilog) as clean BLIF text, model ``top``,
     # kept for multi-level synthesis; empty for specs given as functions
     structure: str = field(default="", repr=False, compare=False)
+    # a spec too wide for a truth table (BLIF, Verilog beyond MAX_TABLE_INPUTS inputs) is
+    # valued by its network alone: ``functions`` then holds no cubes, and every value comes
+    # from simulating this network (no 2**n table anywhere)
+    network: Network | None = field(default=None, repr=False, compare=False)
     _tables: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
 
     @property
@@ -47,7 +52,12 @@ class Spec:
         return len(self.inputs)
 
     def has_table(self) -> bool:
-        return self.n <= MAX_TABLE_INPUTS
+        return self.n <= MAX_TABLE_INPUTS and self.network is None
+
+    @property
+    def by_network(self) -> bool:
+        """Whether the spec is valued by its network (no functions, no table)."""
+        return self.network is not None
 
     def table(self, name: str) -> np.ndarray:
         """Truth table (0/1/DC per minterm) of one output; needs n <= MAX_TABLE_INPUTS."""
@@ -57,7 +67,7 @@ class Spec:
 
     def _build_table(self, f: OutputSpec) -> np.ndarray:
         n = self.n
-        if n > MAX_TABLE_INPUTS:
+        if n > MAX_TABLE_INPUTS or self.network is not None:
             raise ValueError(f"{n} inputs is too many for a truth table")
         if f.expr is not None:
             m = input_matrix(n)
@@ -75,9 +85,12 @@ class Spec:
 
     def values_at(self, bits: np.ndarray) -> dict[str, np.ndarray]:
         """Spec value (0, 1 or DC) of every output at input vectors given as a boolean
-        (n, N) matrix (row k = input k). Uses the truth table up to MAX_TABLE_INPUTS inputs and
-        the cubes beyond (any number of inputs)."""
+        (n, N) matrix (row k = input k). Uses the network of a network-valued spec, else the
+        truth table up to MAX_TABLE_INPUTS inputs and the cubes beyond (any number of inputs)."""
         n = self.n
+        if self.network is not None:
+            vals = self.network.evaluate({x: bits[k] for k, x in enumerate(self.inputs)})
+            return {o: vals[o].astype(np.int8) for o in self.outputs}
         if n <= MAX_TABLE_INPUTS:
             w = (1 << np.arange(n - 1, -1, -1, dtype=np.int64))
             rows = (bits.astype(np.int64) * w[:, None]).sum(axis=0)
@@ -101,6 +114,10 @@ class Spec:
 
     # ---- JSON echo: enough to re-prove a compiled design against -------------------------
     def to_json(self) -> dict:
+        if self.network is not None:  # the network is the spec: its BLIF text is echoed
+            return {"source": self.path, "kind": self.kind, "inputs": list(self.inputs),
+                    "outputs": list(self.outputs), "functions": {},
+                    "network": self.network.to_blif()}
         funcs = {}
         for name in self.outputs:
             f = self.functions[name]

@@ -18,14 +18,14 @@ import json
 from dataclasses import dataclass, field, replace
 
 from mechc.cells.library import Library
-from mechc.errors import MechcError
+from mechc.errors import DesignError, MechcError
 from mechc.ir.equations import Equations
 from mechc.ir.netlist import CellInst, Netlist
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import Cube
 from mechc.logic.yosys import run_yosys
 from mechc.passes.factor import factored_netlist
-from mechc.passes.hazard_cure import cure_hazards
+from mechc.passes.hazard_cure import MAX_SAT_CUBES, cure_hazards
 from mechc.passes.map import map_equations
 from mechc.passes.map_sop import MapOptions
 from mechc.passes.minimise import MinimiseOptions, minimise
@@ -158,11 +158,15 @@ def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
     """Multi-level logic a mechanism can move without glitches: the candidates are ABC's area
     mapping onto the cells (:func:`map_multilevel`) and ABC's K-input cut decomposition with
     every node built by mechc's own two-level minimiser and mapper (a hazard-free cover of a
-    function of at most K nets); each is checked by ternary simulation, and every output that
-    still has a static hazard is built hazard-free instead: from the two-level netlist, or
+    function of at most K nets); each is checked for static hazards (ternary simulation of every
+    change, or SAT from :data:`~mechc.passes.ternary.SAT_MIN_INPUTS` inputs), and every output
+    that still has one is cured by cubes (:mod:`hazard_cure`) or built hazard-free: from the
+    two-level netlist, or
     from the algebraically factored hazard-free covers (``eq`` given; :mod:`factor`), whichever
     has fewer parts; the factored covers are also a candidate of their own. The candidate with
-    the fewest parts is kept."""
+    the fewest parts is kept. A spec too wide for a table comes with neither ``eq`` nor
+    ``two_level``: its candidates are ABC's and the cut networks, cured by SAT; where none can
+    be made hazard-free that is a :class:`DesignError` naming the outputs (exit 1)."""
     cands: list[MultiLevel] = []
     if eq is not None:
         fac = factored_netlist(eq, library, map_opts)
@@ -188,9 +192,11 @@ def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
         cands.append(MultiLevel(nl, {}, _parts(nl, library), f"abc -lut {k}, nodes by mechc"))
     best: MultiLevel | None = None
     tried: dict[str, int] = {}
+    uncured: set[str] = set()
     for c in cands:
         bad = static_hazards(c.netlist)
         if bad:
+            uncured |= set(bad)
             fixes = []  # (netlist, cured locally)
             if two_level is not None:
                 fixes.append((with_two_level(c.netlist, two_level, sorted(bad)), False))
@@ -208,8 +214,11 @@ def map_multilevel_hazard_free(blif: str, inputs: list[str], outputs: list[str],
         tried[c.script] = c.parts
         if best is None or c.parts < best.parts:
             best = c
-    if best is None:
-        raise MechcError("multi-level synthesis found no hazard-free network")
+    if best is None:  # never a design with a hazard unreported: exit 1, saying which
+        raise DesignError("multi-level synthesis found no hazard-free network: the static "
+                          "hazards of " + ", ".join(sorted(uncured)) + " could not be cured "
+                          f"in any of {len(cands)} candidates (a cure by cubes needs at most "
+                          f"{MAX_SAT_CUBES} cubes an output)")
     best.tried = tried
     _describe(best)
     return best

@@ -48,9 +48,9 @@ PRUNE_DEFAULT = False  # per-change pruned scenes (mechc.proofs.prune); see docs
 
 def plan(n: int, extra: int, seed: int) -> list[int]:
     """Input vectors to visit in order, starting from all inputs off."""
-    tour = gray_tour(n)[1:]
-    if n > 10:  # a full tour is too long: a seeded random walk instead
+    if n > 10:  # a full tour is too long (and never built: 2**n entries): a random walk
         return random_walk(n, 0, max(extra, 64), seed)
+    tour = gray_tour(n)[1:]
     walk = random_walk(n, tour[-1] if tour else 0, extra, seed)
     return tour + walk
 

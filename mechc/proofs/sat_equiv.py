@@ -2,14 +2,15 @@
 
 A design too wide to enumerate (see :func:`mechc.proofs.logic.choose_method`) is proved here
 instead of sampled. Netlist and spec are written as one CNF formula (Tseitin variables for
-every net and every sub-expression or cube of the spec); per output, a selector variable is
+every net and every sub-expression or cube of the spec, or every node of a spec valued by its
+network); per output, a selector variable is
 true exactly when the output is cared for and the netlist's value differs from the spec's
 (a miter). The solver (CaDiCaL through python-sat, a maintained SAT library) either finds no
 such input vector, a proof over all 2**n vectors, or returns one, which is checked again by
 plain evaluation (``Netlist.evaluate`` and ``Spec.values_at``) before it is reported, so an
 encoding slip can never show as a false counterexample.
 
-Each cell's clauses come from its truth table computed by
+Each cell's clauses (:mod:`mechc.ir.cnf`) come from its truth table computed by
 :func:`mechc.ir.logic_types.evaluate_type`, the same function the exhaustive check evaluates
 with, so there is one definition of what a cell does. Only cells wider than
 ``TABLE_MAX_INPUTS`` are written by their structure (AND, OR, NAND, NOR: built-in types a cell
@@ -20,102 +21,26 @@ file cannot redefine); a wide cell of another type cannot be encoded
 from __future__ import annotations
 
 from collections.abc import Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from mechc.ir import expr as ex
-from mechc.ir.logic_types import evaluate_type, table_rows
+from mechc.ir.cnf import TABLE_MAX_INPUTS, Cnf, NotEncodable, encode_netlist, encode_network
 from mechc.ir.netlist import Netlist
 from mechc.ir.spec import OutputSpec, Spec
 from mechc.logic.cubes import DC, Cube
 
-#: Cells with at most this many inputs are encoded by their truth table (2**k clauses).
-TABLE_MAX_INPUTS = 8
+# the CNF writer lives in mechc.ir.cnf (the hazard check shares it); its names stay here too
+__all__ = ["EXAMPLES_PER_OUTPUT", "SOLVER", "TABLE_MAX_INPUTS", "Cnf", "Equivalence",
+           "NotEncodable", "check_equivalence", "confirmed_failures", "encode_cubes",
+           "encode_expr", "encode_netlist", "encode_network", "encode_output", "vector_columns"]
+
 #: The solver python-sat runs: CaDiCaL 1.9.5, incremental with assumptions, the fastest of
 #: python-sat's solvers on the t481 miter (2.6 s; glucose 4 5.1 s, minisat 16 s).
 SOLVER = "cadical195"
 #: Counterexamples looked for per failing output (each a distinct input vector).
 EXAMPLES_PER_OUTPUT = 5
-
-
-class NotEncodable(Exception):
-    """A cell the CNF writer cannot express (a wide cell of a type with no structural form)."""
-
-
-@dataclass
-class Cnf:
-    """Clauses over integer variables (python-sat's DIMACS convention), with constants."""
-
-    clauses: list[list[int]] = field(default_factory=list)
-    top: int = 0
-    _true: int = 0
-
-    def new(self) -> int:
-        self.top += 1
-        return self.top
-
-    @property
-    def true(self) -> int:
-        """A variable fixed to true (made on first use)."""
-        if not self._true:
-            self._true = self.new()
-            self.clauses.append([self._true])
-        return self._true
-
-    def and_(self, lits: list[int]) -> int:
-        """y <-> AND(lits)."""
-        if not lits:
-            return self.true
-        if len(lits) == 1:
-            return lits[0]
-        y = self.new()
-        self.clauses += [[-y, a] for a in lits]
-        self.clauses.append([y] + [-a for a in lits])
-        return y
-
-    def or_(self, lits: list[int]) -> int:
-        """y <-> OR(lits)."""
-        return -self.and_([-a for a in lits])
-
-    def xor2(self, a: int, b: int) -> int:
-        y = self.new()
-        self.clauses += [[-y, a, b], [-y, -a, -b], [y, -a, b], [y, a, -b]]
-        return y
-
-    def table(self, ins: list[int], values: np.ndarray) -> int:
-        """y <-> the function with output ``values[row]`` (input 0 the row's MSB)."""
-        k = len(ins)
-        y = self.new()
-        for row, v in enumerate(values):
-            lits = [-ins[i] if (row >> (k - 1 - i)) & 1 else ins[i] for i in range(k)]
-            self.clauses.append(lits + [y if v else -y])
-        return y
-
-
-def encode_netlist(nl: Netlist, cnf: Cnf, inputs: dict[str, int]) -> dict[str, int]:
-    """Every net of ``nl`` as a literal of ``cnf`` (inputs given); returns net -> literal."""
-    nets: dict[str, int] = dict(inputs)
-    cache: dict[tuple, np.ndarray] = {}
-    for cell in nl.topo_cells():
-        ins = [nets[n] for n in cell.inputs]
-        k = len(ins)
-        if k <= TABLE_MAX_INPUTS:
-            key = (cell.type, k, repr(sorted(cell.params.items())))
-            if key not in cache:  # the single definition of the cell's function
-                cache[key] = evaluate_type(cell.type, table_rows(k), cell.params, 1 << k)
-            values = cache[key]
-            y = (cnf.true if values[0] else -cnf.true) if k == 0 else cnf.table(ins, values)
-        elif cell.type in ("AND", "NAND"):
-            y = cnf.and_(ins) * (1 if cell.type == "AND" else -1)
-        elif cell.type in ("OR", "NOR"):
-            y = cnf.or_(ins) * (1 if cell.type == "OR" else -1)
-        else:
-            raise NotEncodable(f"cell {cell.id} ({cell.type}, {k} inputs) has no CNF form "
-                               f"beyond {TABLE_MAX_INPUTS} inputs")
-        for net in cell.outputs:
-            nets[net] = y
-    return nets
 
 
 def encode_expr(e: ex.Expr, cnf: Cnf, inputs: dict[str, int],
@@ -198,8 +123,12 @@ def check_equivalence(nl: Netlist, spec: Spec,
     nets = encode_netlist(nl, cnf, inputs)
     memo: dict = {}
     miters: dict[str, int] = {}
+    by_net = encode_network(spec.network, cnf, inputs) if spec.network is not None else {}
     for o in spec.outputs:
-        care, want = encode_output(spec.functions[o], spec, cnf, inputs, memo)
+        if spec.network is not None:  # every vector is cared for, the network's value
+            care, want = cnf.true, by_net[o]
+        else:
+            care, want = encode_output(spec.functions[o], spec, cnf, inputs, memo)
         got = nets[nl.outputs[o]]
         miters[o] = cnf.and_([care, cnf.xor2(got, want)])
     found: dict[str, list[int]] = {o: [] for o in spec.outputs}
