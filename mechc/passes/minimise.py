@@ -288,9 +288,9 @@ def _has_xor(table: np.ndarray, n: int) -> bool:
 COVER_SHARE = 0.45
 MULTI_SHARE = 0.6
 MULTI_WALL_SHARE = 0.35
-COVER_WALL_SHARE = 0.3
+COVER_WALL_SHARE = 0.45
 #: Past this share of the wall clock the per-output covers left are greedy (no program).
-COVER_WALL_END = 0.3
+COVER_WALL_END = 0.45
 SHARE_SHARE = 0.5
 ALT_SHARE = 0.6
 HAZARD_SHARE = 0.5
