@@ -46,3 +46,18 @@ def pla_text(inputs, tables: dict[str, np.ndarray], shuffle_rng=None) -> str:
         shuffle_rng.shuffle(rows)
     return "\n".join([f".i {n}", f".o {len(outs)}", ".ilb " + " ".join(inputs),
                       ".ob " + " ".join(outs), ".type fd", f".p {len(rows)}", *rows, ".e"]) + "\n"
+
+
+def amplified_and(lib):
+    """(netlist, spec) of z = a & b with a force AMPLIFIER on a: the smallest design whose
+    timing goes through a toggle, built by hand because compile puts none on so light a load."""
+    from mechc.frontends.boolfile import parse_bool
+    from mechc.ir.netlist import CellInst, Netlist
+
+    nl = Netlist(["a", "b"])
+    nl.add_cell(CellInst("g1", "amplifier", "AMPLIFIER", ("a",), ("n1",), {"reason": "force"}),
+                pin_names=lib["amplifier"].input_names(1))
+    nl.add_cell(CellInst("g2", "and", "AND", ("n1", "b"), ("z",)),
+                pin_names=lib["and"].input_names(2))
+    nl.set_output("z", "z")
+    return nl, parse_bool("inputs a b\noutputs z\nz = a & b\n", "<amplified>")

@@ -14,7 +14,6 @@ import pytest
 from mechc.bench.circuits import random_netlist
 from mechc.cells.library import load_library
 from mechc.frontends import load_spec
-from mechc.frontends.boolfile import parse_bool
 from mechc.frontends.fsm import parse_fsm_file
 from mechc.ir.logic_types import evaluate_type
 from mechc.ir.netlist import CellInst, Netlist
@@ -37,7 +36,7 @@ from mechc.proofs.screen import (
     prove_screened,
 )
 from mechc.proofs.settings import dyn_settings
-from tests.helpers import EXAMPLES
+from tests.helpers import EXAMPLES, amplified_and
 
 LIB = load_library()
 
@@ -279,14 +278,7 @@ def test_a_move_time_the_tables_never_measured_goes_to_dynamics():
 @pytest.fixture(scope="module")
 def amplified():
     """z = a & b with a powered AMPLIFIER on a (a toggle, timed as built), compiled."""
-    amp = LIB["amplifier"]
-    nl = Netlist(["a", "b"])
-    nl.add_cell(CellInst("g1", "amplifier", "AMPLIFIER", ("a",), ("n1",), {"reason": "force"}),
-                pin_names=amp.input_names(1))
-    nl.add_cell(CellInst("g2", "and", "AND", ("n1", "b"), ("z",)),
-                pin_names=LIB["and"].input_names(2))
-    nl.set_output("z", "z")
-    spec = parse_bool("inputs a b\noutputs z\nz = a & b\n", "<amplified>")
+    nl, spec = amplified_and(LIB)
     return compile_netlist(spec, nl, library=LIB)
 
 

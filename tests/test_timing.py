@@ -21,7 +21,7 @@ from mechc.proofs import ProofSettings, prove
 from mechc.proofs.dynamic import plan
 from mechc.proofs.settings import dyn_settings
 from mechc.proofs.timing import cell_tables, inequality, predict_changes, sample_times
-from tests.helpers import EXAMPLES
+from tests.helpers import EXAMPLES, amplified_and
 
 LIB = load_library()
 
@@ -205,14 +205,8 @@ def test_amplifier_is_timed_as_built_and_predicts_its_landing(tmp_path, monkeypa
     timed as the design built it (a table per geometry, cached), and the settle time it
     predicts for the output behind it is within 15 % of the whole scene's."""
     monkeypatch.setenv("MECHC_CACHE_DIR", str(tmp_path))
-    amp = LIB["amplifier"]
-    nl = Netlist(["a", "b"])
-    nl.add_cell(CellInst("g1", "amplifier", "AMPLIFIER", ("a",), ("n1",), {"reason": "force"}),
-                pin_names=amp.input_names(1))
-    nl.add_cell(CellInst("g2", "and", "AND", ("n1", "b"), ("z",)),
-                pin_names=LIB["and"].input_names(2))
-    nl.set_output("z", "z")
-    d = compile_netlist(load_spec_text("inputs a b\noutputs z\nz = a & b\n"), nl, library=LIB)
+    nl, spec = amplified_and(LIB)
+    d = compile_netlist(spec, nl, library=LIB)
     names = ["a", "b"]
     changes = [(0b01, 0b11), (0b11, 0b01)]  # b on: a switches z on, then off
     st = dyn_settings(d)
