@@ -57,13 +57,16 @@ def parse_blif_file(path: str) -> Spec:
 def parse_blif(text: str, path: str = "<string>") -> Spec:
     inputs, outputs, nodes = _read(text, path)
     order = _topological(nodes, inputs, outputs, path)
-    structure = network_blif(inputs, outputs, nodes, order)
+    # every node, dangling ones too, as the author wrote them: what synthesis starts from
+    structure = network_of(inputs, outputs, nodes, order, cone_only=False).to_blif()
+    network = network_of(inputs, outputs, nodes, order)
     names_in, names_out = [w.text for w in inputs], [w.text for w in outputs]
     if len(inputs) > TABLE_MAX_BLIF_INPUTS:  # valued by the network: no 2**n anything
         funcs = {o.text: OutputSpec(o.text, line=nodes[o.text].out.line) for o in outputs}
         return Spec(path, "pla", names_in, names_out, funcs, structure=structure,
-                    network=network_of(inputs, outputs, nodes, order))
-    tables = _evaluate(nodes, order, inputs, outputs)
+                    network=network)
+    mat = input_matrix(len(inputs))
+    tables = network.evaluate({x: mat[k] for k, x in enumerate(names_in)})
     funcs = {}
     for o in outputs:
         funcs[o.text] = OutputSpec(o.text, on=table_cover(tables[o.text], len(inputs)),
@@ -72,28 +75,16 @@ def parse_blif(text: str, path: str = "<string>") -> Spec:
 
 
 def network_of(inputs: list[Word], outputs: list[Word], nodes: dict[str, Node],
-               order: list[str]) -> Network:
-    """The nodes the outputs depend on, in evaluation order, as the IR's network."""
-    needed = _cone(nodes, outputs)
+               order: list[str], cone_only: bool = True) -> Network:
+    """The nodes in evaluation order as the IR's network: those the outputs depend on, or
+    with ``cone_only=False`` every node (the clean BLIF text the spec keeps as its
+    structure, one line per cube, no comments or continuations)."""
+    needed = _cone(nodes, outputs) if cone_only else set(order)
     return Network([w.text for w in inputs], [w.text for w in outputs],
                    [NamesNode(name, tuple(f.text for f in nodes[name].fanins),
                               tuple(nodes[name].cubes),
                               0 if nodes[name].phase == 0 else 1)
                     for name in order if name in needed])
-
-
-def network_blif(inputs: list[Word], outputs: list[Word], nodes: dict[str, Node],
-                 order: list[str]) -> str:
-    """The network as clean BLIF (model ``top``, one line per cube, no comments or
-    continuations, nodes in evaluation order): what multi-level synthesis starts from, so the
-    structure the author gave is kept rather than flattened to a table."""
-    lines = [".model top", ".inputs " + " ".join(w.text for w in inputs),
-             ".outputs " + " ".join(w.text for w in outputs)]
-    for name in order:
-        nd = nodes[name]
-        lines.append(".names " + " ".join([f.text for f in nd.fanins] + [name]))
-        lines += [f"{c} {nd.phase}".strip() for c in nd.cubes]
-    return "\n".join(lines + [".end"]) + "\n"
 
 
 def logical_lines(text: str) -> list[list[Word]]:
@@ -271,41 +262,6 @@ def _topological(nodes: dict[str, Node], inputs: list[Word], outputs: list[Word]
                 order.append(name)
                 stack.pop()
     return order
-
-
-def _evaluate(nodes: dict[str, Node], order: list[str], inputs: list[Word],
-              outputs: list[Word]) -> dict[str, np.ndarray]:
-    """Each output's value on every input vector; a node's array is dropped once its last
-    reader has been evaluated, so wide networks stay within memory."""
-    n = len(inputs)
-    size = 1 << n
-    mat = input_matrix(n)
-    values: dict[str, np.ndarray] = {w.text: mat[k] for k, w in enumerate(inputs)}
-    needed = _cone(nodes, outputs)
-    readers: dict[str, int] = {}
-    for name in needed:
-        for f in nodes[name].fanins:
-            readers[f.text] = readers.get(f.text, 0) + 1
-    keep = {o.text for o in outputs}
-    for name in order:
-        if name not in needed:
-            continue
-        nd = nodes[name]
-        hit = np.zeros(size, dtype=bool)
-        for cube in nd.cubes:
-            term = np.ones(size, dtype=bool)
-            for ch, f in zip(cube, nd.fanins):
-                if ch == "1":
-                    term &= values[f.text]
-                elif ch == "0":
-                    term &= ~values[f.text]
-            hit |= term
-        values[name] = ~hit if nd.phase == 0 else hit
-        for f in nd.fanins:
-            readers[f.text] -= 1
-            if readers[f.text] == 0 and f.text in nodes and f.text not in keep:
-                del values[f.text]
-    return {o.text: values[o.text] for o in outputs}
 
 
 def _cone(nodes: dict[str, Node], outputs: list[Word]) -> set[str]:

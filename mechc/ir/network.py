@@ -33,10 +33,17 @@ class Network:
     nodes: list[NamesNode]
 
     def evaluate(self, values: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """Every output's boolean value at the input vectors ``values`` (input -> array)."""
+        """Every output's boolean value at the input vectors ``values`` (input -> array). A
+        node's array is dropped once its last reader has been evaluated, so a wide network
+        over 2**20 vectors stays within memory."""
         size = len(next(iter(values.values()))) if values else 1
         nets: dict[str, np.ndarray] = {x: np.asarray(values[x], dtype=bool)
                                        for x in self.inputs}
+        readers: dict[str, int] = {}
+        for nd in self.nodes:
+            for f in nd.fanins:
+                readers[f] = readers.get(f, 0) + 1
+        keep = set(self.outputs) | set(self.inputs)
         for nd in self.nodes:
             hit = np.zeros(size, dtype=bool)
             for cube in nd.cubes:
@@ -48,6 +55,10 @@ class Network:
                         term &= ~nets[f]
                 hit |= term
             nets[nd.out] = ~hit if nd.phase == 0 else hit
+            for f in nd.fanins:
+                readers[f] -= 1
+                if readers[f] == 0 and f not in keep:
+                    del nets[f]
         return {o: nets[o] for o in self.outputs}
 
     def to_blif(self) -> str:
