@@ -85,7 +85,7 @@ def measure(design, changes, names, st) -> tuple[list[dict], float]:
         sc = Scene.build(mech, LIB, types, st, start)
         r = sc.move(names[k], float((vec >> (n - 1 - k)) & 1))
         t = np.concatenate([[0.0], r.t])
-        got = {}
+        got = {"__scene_settle_s": st.move_time + r.settle_time}
         for o, s in r.outputs.items():
             s = np.concatenate([[s[0]], s])
             got[o] = {"switch_s": crossing(t, s), "settle_s": settled_at(t, s)}
@@ -118,14 +118,19 @@ def main() -> None:
         tables, tabs = cell_tables(design, LIB, None, names, changes)
         t_char = time.perf_counter() - t0
         t0 = time.perf_counter()
-        pred = predict_changes(design, LIB, names, changes, st, tables)
+        pred = predict_changes(design, LIB, names, changes, st, tables, detail=True)
         t_pred = time.perf_counter() - t0
         t0 = time.perf_counter()
         full = prove_timing(design, spec, LIB, ProofSettings())
         t_level = time.perf_counter() - t0
         meas, t_dyn = measure(design, changes, names, st)
-        errs, cf_errs, sw_errs = [], [], []
+        errs, cf_errs, sw_errs, nets_early = [], [], [], []
         for p, m in zip(pred, meas):
+            # what the screened proof reads: the latest settle of any switching net, against
+            # the scene's own settle (every output within 0.5 % of its end); > 0 is early
+            if p["switched"] and np.isfinite(m["__scene_settle_s"]):
+                nets_early.append((m["__scene_settle_s"] - p["nets_settle_s"])
+                                  / m["__scene_settle_s"])
             for o, po in p["outputs"].items():
                 mo = m.get(o)
                 if mo is None or not np.isfinite(mo["switch_s"]):
@@ -151,6 +156,9 @@ def main() -> None:
             "max_settle_error": float(e.max()) if len(e) else 0.0,
             "mean_settle_error": float(e.mean()) if len(e) else 0.0,
             "max_switch_error": float(np.max(np.abs(sw_errs))) if sw_errs else 0.0,
+            "max_settle_early": float(max(0.0, -min(errs))) if errs else 0.0,
+            "max_settle_late": float(max(0.0, max(errs))) if errs else 0.0,
+            "max_nets_settle_early": float(max(0.0, max(nets_early))) if nets_early else 0.0,
             "max_closed_form_settle_error": float(np.max(np.abs(cf_errs))) if cf_errs else 0.0,
             "timing_s_per_change": t_pred / max(1, len(changes)),
             "dynamic_s_per_change": t_dyn / max(1, len(changes)),
@@ -170,7 +178,9 @@ def main() -> None:
     for s in summary:
         print(f"  {s['circuit']:12s} {s['cells']:3d} cells {s['changes']:3d} changes: settle "
               f"max err {s['max_settle_error']:.2%} (closed form alone "
-              f"{s['max_closed_form_settle_error']:.2%}), switch max err "
+              f"{s['max_closed_form_settle_error']:.2%}; late {s['max_settle_late']:.2%}, "
+              f"early {s['max_settle_early']:.2%}; screen's nets settle early "
+              f"{s['max_nets_settle_early']:.2%}), switch max err "
               f"{s['max_switch_error']:.2%}; timing {s['timing_s_per_change'] * 1e3:.2f} ms/"
               f"change vs dynamic {s['dynamic_s_per_change']:.3f} s/change "
               f"({s['dynamic_s_per_change'] / max(s['timing_s_per_change'], 1e-9):.0f}x)")

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import networkx as nx
 import numpy as np
@@ -39,11 +40,12 @@ from mechc.cells.characterise import (
 )
 from mechc.cells.library import Library
 from mechc.ir.design import Design
+from mechc.ir.mechanism import GROUND
 from mechc.ir.netlist import Netlist
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
 from mechc.parts.pushrod import net_rods
-from mechc.physics.evaluate import evaluate, output_signals
+from mechc.physics.evaluate import evaluate, output_signals, signal_of
 from mechc.physics.scene import DynSettings, min_jerk
 from mechc.proofs.dynamic import plan
 from mechc.proofs.kinematic import prove_kinematic
@@ -239,6 +241,8 @@ def predict_changes(design: Design, lib: Library, names: list[str],
     figs = {cid: ({**tab.at(st.move_time, loads.get(nl.cells[cid].outputs[0], 0.0)),
                    "as_built": tab.as_built} if tab is not None else None)
             for cid, tab in tables.items()}
+    follow = followers(design, lib)
+    hold = st.move_time + st.settle_time
     out: list[dict] = []
     frac = np.linspace(0.0, 1.0, SAMPLES)
     for lo in range(0, len(changes), CHUNK):
@@ -251,7 +255,13 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 b = (vec >> (n - 1 - k)) & 1
                 cols.append(a + (b - a) * frac)
             vals[nm] = np.concatenate(cols)
-        sig = output_signals(mech, evaluate(mech, lib, types, vals))
+        poses = evaluate(mech, lib, types, vals)
+        sig = output_signals(mech, poses)
+        bodies = mech.body_index() if follow else {}
+        fsig = {}
+        for cid in follow:
+            term = mech.cells[cid].terminals[lib[types[cid]].outputs[0]]
+            fsig[cid] = signal_of(term, bodies[term.body], poses)
         logic = nl.evaluate({nm: np.array([[(v >> (n - 1 - k)) & 1 for v in pair]
                                            for pair in chunk], dtype=bool).ravel()
                              for k, nm in enumerate(names)})
@@ -259,7 +269,17 @@ def predict_changes(design: Design, lib: Library, names: list[str],
             k = n - (cur ^ vec).bit_length()
             moving = names[k]
             switched = {net for net, v in logic.items() if v[2 * i] != v[2 * i + 1]}
-            arrive, settle, path = _paths(nl, "in:" + moving, switched, figs)
+            here = figs
+            for cid, fo in follow.items():
+                if fo.net in switched and figs.get(cid) is not None:
+                    got = _follow(fo, ts, fsig[cid][i * SAMPLES:(i + 1) * SAMPLES], hold)
+                    if got is not None:
+                        if here is figs:
+                            here = dict(figs)
+                        f = figs[cid]
+                        here[cid] = {**f, "lag_s": max(f["lag_s"], got[0]),
+                                     "settle_extra_s": max(f["settle_extra_s"], got[1])}
+            arrive, settle, path = _paths(nl, "in:" + moving, switched, here)
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
             if detail:
@@ -295,6 +315,22 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 rec["nets_settle_s"] = max(rec["nets_settle_s"], rec["settle_s"])
             out.append(rec)
     return out
+
+
+def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
+            ) -> tuple[float, float] | None:
+    """How much later than its closed form ``cf`` (at times ``ts``) a follower's output
+    crosses mid-stroke and settles, by :meth:`Follower.run`; None when the closed form does
+    not cross."""
+    cf_cross = crossing(ts, cf)
+    if not math.isfinite(cf_cross):
+        return None
+    t, x = fo.run(ts, cf, until)
+    cross = crossing(t, x)
+    if not math.isfinite(cross):
+        cross = until
+    cf_settle = settled_at(ts, cf, end=float(cf[-1]), within=SETTLED)
+    return cross - cf_cross, settled_at(t, x, end=float(cf[-1]), within=SETTLED) - cf_settle
 
 
 def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | None]
@@ -440,3 +476,150 @@ def _sum_paths(g: nx.MultiDiGraph, delay: dict[str, float], starts: list[str], p
         if came:
             best[node] = pick(came) + delay.get(node, 0.0)
     return best
+
+
+# ---- a spring-driven output: how fast its own spring can move what its net carries --------
+#: Time step (s) of the one-dimensional follower model.
+FOLLOW_DT = 2.5e-4
+
+
+@dataclass
+class Follower:
+    """A cell output body that a spring of its own moves one way, held back by one-sided
+    contacts with the cell's inputs (a bar gate's bar): going that way it can lead nowhere
+    and lags when the spring, less the guides' friction, cannot accelerate the body and
+    what its net carries as fast as the closed form asks. Its net's loads must be free (no
+    load holds a sprung part against its input), so the spring is the only force moving
+    the net: then this is the whole force balance, read from the parts as built."""
+
+    cid: str
+    net: str
+    mass: float  # kg: the output body, the net's rods and its loads' input sliders
+    friction: float  # N: Coulomb guide friction of every slider that moves
+    stroke: float  # mm
+    axis: tuple[float, float]  # unit vector off -> on
+    start: tuple[float, float]  # the terminal's point at signal 0 (off)
+    design: tuple[float, float]  # the body's terminal point at the design pose
+    springs: list[tuple[tuple[float, float], tuple[float, float], float, float, float]]
+    #        (ground anchor, attachment at the design pose, rate N/mm, rest mm, damping N s/mm)
+
+    def force(self, x: float) -> tuple[float, float]:
+        """The springs' pull along the output's axis (N, + towards on) with the output at
+        signal ``x``, and their damping (N s/mm) along it."""
+        ux, uy = self.axis
+        dx = (self.start[0] + ux * x * self.stroke) - self.design[0]
+        dy = (self.start[1] + uy * x * self.stroke) - self.design[1]
+        f = c = 0.0
+        for (ax, ay), (px, py), rate, rest, damp in self.springs:
+            vx, vy = ax - (px + dx), ay - (py + dy)
+            ln = math.hypot(vx, vy)
+            if ln > rest and ln > 0.0:
+                proj = (vx * ux + vy * uy) / ln
+                f += rate * (ln - rest) * proj
+                c += damp * proj * proj
+        return f, c
+
+    def run(self, ts: np.ndarray, hook: np.ndarray, until: float) -> tuple[np.ndarray,
+                                                                          np.ndarray]:
+        """The output's path (signal) while the input-held bound ``hook`` (the closed form at
+        times ``ts``, held at its end after them) moves: free under spring, damping and
+        friction, never beyond the bound on the spring's side, stopped at the end the spring
+        pulls to."""
+        n = int(until / FOLLOW_DT) + 1
+        t = np.arange(n) * FOLLOW_DT
+        h = np.interp(t, ts, hook)
+        pull = 1.0 if self.force(0.5)[0] >= 0.0 else -1.0
+        end = 1.0 if pull > 0 else 0.0
+        x, v = float(h[0]), 0.0  # signal, signal/s
+        out = np.empty(n)
+        k = 1000.0 / (self.mass * self.stroke)  # N -> signal/s^2
+        for i in range(n):
+            if i:
+                f, c = self.force(x)
+                f -= c * v * self.stroke
+                if v != 0.0:
+                    f -= math.copysign(self.friction, v)
+                elif abs(f) <= self.friction:
+                    f = 0.0
+                else:
+                    f -= math.copysign(self.friction, f)
+                v += f * k * FOLLOW_DT
+                x += v * FOLLOW_DT
+                if pull * (x - h[i]) > 0.0:  # the inputs hold it back: it rides the bound
+                    x, v = float(h[i]), (float(h[i]) - float(h[i - 1])) / FOLLOW_DT
+                if pull * (x - end) > 0.0:  # its stop
+                    x, v = end, 0.0
+                if v == 0.0 and t[i] > ts[-1] and x == h[i]:  # at rest where the move left it
+                    out[i:] = x
+                    break
+            out[i] = x
+        return t, out
+
+
+def followers(design: Design, lib: Library) -> dict[str, Follower]:
+    """Every cell whose output body is a :class:`Follower` (see there) and whose net's loads
+    are free: no sprung part of a load cell touches the load's input body (an AMPLIFIER's
+    input, a design output); a load that presses on its input helps or resists depending on
+    its own state, which the cell tables cover instead."""
+    mech, nl = design.mechanism, design.netlist
+    index = mech.body_index()
+    loads = net_loads(design)
+    S, fr = mech.ctx.stroke, mech.ctx.friction
+
+    def pressed(body: str, part) -> bool:
+        """Whether ``body`` has a one-sided contact with another moving body of ``part``."""
+        return any(j.kind in ("contact", "touch") and body in (j.a, j.b)
+                   and GROUND not in (j.a, j.b) for j in part.joints)
+
+    def sprung_load(body: str, part) -> bool:
+        """Whether a part of load cell ``part`` sprung to the ground touches ``body`` or
+        what moves rigidly with it (rods, pins, grooves): then the load pushes on the net."""
+        group, todo = {body}, [body]
+        while todo:
+            b = todo.pop()
+            for j in part.joints:
+                if j.kind in ("rod", "pin", "groove") and b in (j.a, j.b):
+                    o = j.b if j.a == b else j.a
+                    if o != GROUND and o not in group:
+                        group.add(o)
+                        todo.append(o)
+        sprung = {s.b if s.a == GROUND else s.a for s in part.springs
+                  if GROUND in (s.a, s.b)}
+        return any(j.kind in ("contact", "touch")
+                   and ((j.a in group and j.b in sprung) or (j.b in group and j.a in sprung))
+                   for j in part.joints)
+
+    out: dict[str, Follower] = {}
+    for c in nl.cells.values():
+        cls = lib[c.cell]
+        if cls.stateful or per_instance(cls) or c.id not in mech.cells:
+            continue
+        part = mech.cells[c.id]
+        term = part.terminals.get(cls.outputs[0])
+        net = c.outputs[0]
+        if term is None or term.kind != "translating" or net not in mech.nets:
+            continue
+        body = term.body
+        springs = []
+        for s in part.springs:
+            if s.b == body and s.a == GROUND:
+                springs.append((s.pa, s.pb, s.rate, s.rest, s.damping))
+            elif s.a == body and s.b == GROUND:
+                springs.append((s.pb, s.pa, s.rate, s.rest, s.damping))
+        if not springs or not pressed(body, part):
+            continue
+        sliders = 1 if index[body].kind == "slider" else 0
+        free = True
+        for r in net_rods(mech.nets[net]):
+            owner = mech.cells.get(r.load.split(".", 1)[0])
+            if owner is None or sprung_load(r.load, owner):
+                free = False
+                break
+            sliders += index[r.load].kind == "slider" if r.load in index else 0
+        if not free:
+            continue
+        dx, dy = term.on[0] - term.off[0], term.on[1] - term.off[1]
+        ln = math.hypot(dx, dy)
+        out[c.id] = Follower(c.id, net, index[body].mass + loads.get(net, 0.0), fr * sliders,
+                             S, (dx / ln, dy / ln), term.off, term.design_point, springs)
+    return out
