@@ -44,7 +44,7 @@ from mechc.cells.prove_cell import alone
 from mechc.physics.scene import DynSettings, Scene
 
 #: Bump when what is measured or how changes: older tables are then measured again.
-VERSION = 1
+VERSION = 3
 #: Input move times (s) of the grid: 2x faster and 2x slower than the proofs' default 0.08 s.
 MOVE_TIMES = (0.04, 0.08, 0.16)
 #: Masses (kg) added to the output body: none, about one load's slider and rod, about three.
@@ -56,6 +56,11 @@ SETTLED = 0.005
 UNTIMED = frozenset({"MEMORY", "CONST"})
 SHIPPED = Path(__file__).with_name("characterised.json")
 FIGURES = ("lag_s", "settle_extra_s", "overshoot", "force_N")
+#: Figures also kept per direction of the output's switch, ``lag_on_s`` for the output
+#: switching on, ``lag_off_s`` off (a bar moved by its spring one way and pushed by its inputs
+#: the other lags differently each way; ``lag_s`` is the worse of the two). A table without
+#: them (an older one) serves both directions with the worse.
+DIRECTED = ("lag_s", "settle_extra_s")
 
 #: Called as (done, total) while a cell is measured.
 OnProgress = Callable[[int, int], None]
@@ -200,17 +205,21 @@ def measure_in(design, lib: Library, cid: str, moves: list[Move],
                     _unprefixed(part.to_json(), cid))
     types = {x.id: x.cell for x in design.netlist.cells.values()}
     out_body = part.terminals[cls.outputs[0]].body
-    values = {f: [[0.0] * len(LOADS) for _ in MOVE_TIMES] for f in FIGURES}
+    names = [*FIGURES, *(directed(f, on) for f in DIRECTED for on in (True, False))]
+    values = {f: [[0.0] * len(LOADS) for _ in MOVE_TIMES] for f in names}
     total, done = len(MOVE_TIMES) * len(LOADS), 0
     for i, mt in enumerate(MOVE_TIMES):
         for j, load in enumerate(LOADS):
-            worst = dict.fromkeys(FIGURES, 0.0)
+            worst = dict.fromkeys(names, 0.0)
             for mv in moves:
                 got = _one_change(mech, lib, types, cid, mv, mt, load, out_body,
                                   cls.outputs[0])
                 for f in FIGURES:
                     worst[f] = max(worst[f], got[f])
-            for f in FIGURES:
+                for f in DIRECTED:
+                    k = directed(f, got["on"])
+                    worst[k] = max(worst[k], got[f])
+            for f in names:
                 values[f][i][j] = round(worst[f], 6)
             done += 1
             if progress is not None:
@@ -251,7 +260,12 @@ def _one_change(mech, lib, types, cid: str, mv: Move, move_time: float, load: fl
     force = body.mass * float(np.max(np.abs(acc))) / 1000.0  # kg mm/s^2 -> N
     return {"lag_s": lag if math.isfinite(lag) else 0.0,
             "settle_extra_s": extra if math.isfinite(extra) else 0.0,
-            "overshoot": over, "force_N": force}
+            "overshoot": over, "force_N": force, "on": bool(ref[-1] > ref[0])}
+
+
+def directed(figure: str, on: bool) -> str:
+    """The name of ``figure`` (one of ``DIRECTED``) for the output switching on or off."""
+    return figure.replace("_s", "_on_s" if on else "_off_s", 1)
 
 
 def crossing(t: np.ndarray, x: np.ndarray, level: float = 0.5) -> float:

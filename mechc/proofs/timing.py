@@ -30,11 +30,13 @@ import networkx as nx
 import numpy as np
 
 from mechc.cells.characterise import (
+    DIRECTED,
     SETTLED,
     CellTable,
     Move,
     Tables,
     crossing,
+    directed,
     per_instance,
     settled_at,
 )
@@ -269,16 +271,20 @@ def predict_changes(design: Design, lib: Library, names: list[str],
             k = n - (cur ^ vec).bit_length()
             moving = names[k]
             switched = {net for net, v in logic.items() if v[2 * i] != v[2 * i + 1]}
-            here = figs
-            for cid, fo in follow.items():
-                if fo.net in switched and figs.get(cid) is not None:
-                    got = _follow(fo, ts, fsig[cid][i * SAMPLES:(i + 1) * SAMPLES], hold)
-                    if got is not None:
-                        if here is figs:
-                            here = dict(figs)
-                        f = figs[cid]
-                        here[cid] = {**f, "lag_s": max(f["lag_s"], got[0]),
-                                     "settle_extra_s": max(f["settle_extra_s"], got[1])}
+            # each switching cell's figures for the way its output goes (on or off)
+            here = dict(figs)
+            for c in nl.cells.values():
+                f = figs.get(c.id)
+                if f is None or c.outputs[0] not in switched:
+                    continue
+                on = bool(logic[c.outputs[0]][2 * i + 1])
+                here[c.id] = f = {**f, **{k: f.get(directed(k, on), f[k]) for k in DIRECTED}}
+                fo = follow.get(c.id)
+                got = (_follow(fo, ts, fsig[c.id][i * SAMPLES:(i + 1) * SAMPLES], hold)
+                       if fo is not None else None)
+                if got is not None:
+                    f["lag_s"] = max(f["lag_s"], got[0])
+                    f["settle_extra_s"] = max(f["settle_extra_s"], got[1])
             arrive, settle, path = _paths(nl, "in:" + moving, switched, here)
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
