@@ -2,14 +2,23 @@
 moved on by its own spring, its net's only load a free AMPLIFIER input, against the whole-scene
 pymunk run of the same change. The bar is made heavier than compile builds it, so the closed
 form (and the cell's table, measured on the cell compiled alone) is far too early: the follower
-model must bring the net's switching and settle within 15 % of the scene."""
+model must bring the net's switching and settle within 15 % of the scene. And the cells'
+tables per direction of the output's switch, read by the way each cell switches."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from mechc.cells.characterise import Tables, crossing, settled_at
+from mechc.cells.characterise import (
+    DIRECTED,
+    STANDARD,
+    CellTable,
+    Tables,
+    crossing,
+    directed,
+    settled_at,
+)
 from mechc.cells.library import load_library
 from mechc.frontends.boolfile import parse_bool
 from mechc.ir.netlist import CellInst, Netlist
@@ -100,3 +109,41 @@ def test_follower_rides_its_bound_when_the_spring_is_strong():
     cf = np.linspace(0.0, 1.0, SAMPLES)  # the input's position at those times
     lag, extra = _follow(fo, ts, cf, 0.23)
     assert abs(lag) < 1e-3 and abs(extra) < 1e-3
+
+
+def test_shipped_tables_keep_each_direction_and_the_worse_of_the_two():
+    """Every shipped table has its lag and settle extra per direction of the output's switch,
+    the undirected figure their worse; a bar gate lags only the way its spring moves it."""
+    tabs = Tables(LIB)
+    for cell, type_name, n in STANDARD:
+        tab = tabs.get(cell, type_name, n, {}, 20.0)
+        for f in DIRECTED:
+            both = np.maximum(tab.values[directed(f, True)], tab.values[directed(f, False)])
+            assert np.allclose(both, tab.values[f], atol=1e-6)
+    heavy = {"move_time": 0.08, "load": 0.09}
+    and_ = tabs.get("and", "AND", 2, {}, 20.0).at(*heavy.values())
+    or_ = tabs.get("or", "OR", 2, {}, 20.0).at(*heavy.values())
+    assert and_["lag_on_s"] > 10 * and_["lag_off_s"]  # the AND spring moves its bar on
+    assert or_["lag_off_s"] > 10 * or_["lag_on_s"]  # the OR spring moves its bar off
+
+
+def test_timing_reads_the_lag_of_the_way_the_cell_switches():
+    """A cell's on and off lags differ: each change is given the one of its direction."""
+    spec = parse_bool("inputs a b\noutputs z\nz = a & b\n", "<and>")
+    nl = Netlist(["a", "b"])
+    nl.add_cell(CellInst("c1", "and", "AND", ("a", "b"), ("z",), {}),
+                pin_names=LIB["and"].input_names(2))
+    nl.set_output("z", "z")
+    d = compile_netlist(spec, nl, CompileOptions(), LIB)
+    base = Tables(LIB).get("and", "AND", 2, {}, 20.0)
+    grid = np.ones((3, 3))
+    values = {**base.values, "lag_on_s": (0.006 * grid).tolist(),
+              "lag_off_s": (0.001 * grid).tolist(), "lag_s": (0.006 * grid).tolist()}
+    tab = CellTable("k", "and", "AND", 2, {}, 20.0, base.move_times, base.loads, values, 4)
+    st = dyn_settings(d)
+    on, off = predict_changes(d, LIB, ["a", "b"], [(0b10, 0b11), (0b11, 0b10)], st,
+                              {"c1": tab})
+    lag_on = on["outputs"]["z"]["switch_s"] - on["outputs"]["z"]["closed_form_switch_s"]
+    lag_off = off["outputs"]["z"]["switch_s"] - off["outputs"]["z"]["closed_form_switch_s"]
+    assert lag_on == pytest.approx(0.006, abs=3e-4)
+    assert lag_off == pytest.approx(0.001, abs=3e-4)

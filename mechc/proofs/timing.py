@@ -6,8 +6,12 @@ move is what the closed form says for the input's position then. So per change (
 proof's own plan) the whole mechanism's closed form is evaluated along the move, and each
 sample's time is where the minimum-jerk profile puts that input position. On top, each cell
 on the switching path adds what its table says the dynamics add at its input speed and the
-mass its output net drives: the lag of its mid-stroke crossing, and (the last cell) how much
-later it settles; an AMPLIFIER, timed as the design built it, passes its late landing on.
+mass its output net drives, for the way its output switches: the lag of its mid-stroke
+crossing, and (the last cell) how much later it settles; an AMPLIFIER, timed as the design
+built it, passes its late landing on. A gate whose output body only its own spring moves one
+way (a bar held back by its inputs) and whose net's loads are free is timed as built too, by
+a one-dimensional model of that body (:class:`Follower`): its spring, the guides' friction and
+the mass it moves, as the parts give them.
 Path delays are the longest sum through the cells whose output switches (static timing
 analysis over the netlist's DAG).
 
