@@ -109,6 +109,7 @@ def test_follower_rides_its_bound_when_the_spring_is_strong():
     cf = np.linspace(0.0, 1.0, SAMPLES)  # the input's position at those times
     lag, extra = _follow(fo, ts, cf, 0.23)
     assert abs(lag) < 1e-3 and abs(extra) < 1e-3
+    assert _follow(fo, ts, cf[::-1], 0.23) is None  # pushed against its spring: not its case
 
 
 def test_shipped_tables_keep_each_direction_and_the_worse_of_the_two():

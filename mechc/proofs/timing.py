@@ -330,11 +330,12 @@ def predict_changes(design: Design, lib: Library, names: list[str],
 def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
             ) -> tuple[float, float] | None:
     """How much later than its closed form ``cf`` (at times ``ts``) a follower's output
-    crosses mid-stroke and settles, by :meth:`Follower.run`; None when the closed form does
-    not cross."""
+    crosses mid-stroke and settles when its spring moves it, by :meth:`Follower.run`; None
+    when the closed form does not cross or the output is pushed against its spring."""
     cf_cross = crossing(ts, cf)
-    if not math.isfinite(cf_cross):
-        return None
+    pull = fo.force(0.5)[0]
+    if not math.isfinite(cf_cross) or pull * (cf[-1] - cf[0]) <= 0.0:
+        return None  # pushed against its spring: the inputs move it, the table times it
     t, x = fo.run(ts, cf, until)
     cross = crossing(t, x)
     if not math.isfinite(cross):
