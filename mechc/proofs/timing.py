@@ -582,9 +582,11 @@ def followers(design: Design, lib: Library) -> dict[str, Follower]:
         return any(j.kind in ("contact", "touch") and body in (j.a, j.b)
                    and GROUND not in (j.a, j.b) for j in part.joints)
 
-    def sprung_load(body: str, part) -> bool:
+    def sprung_load(body: str, part, out_body: str | None) -> bool:
         """Whether a part of load cell ``part`` sprung to the ground touches ``body`` or
-        what moves rigidly with it (rods, pins, grooves): then the load pushes on the net."""
+        what moves rigidly with it (rods, pins, grooves): then the load pushes on the net.
+        So does a load that moves its own output (``out_body``) rigidly with its input (a
+        NOT lever): the net then carries that output's loads too."""
         group, todo = {body}, [body]
         while todo:
             b = todo.pop()
@@ -594,6 +596,8 @@ def followers(design: Design, lib: Library) -> dict[str, Follower]:
                     if o != GROUND and o not in group:
                         group.add(o)
                         todo.append(o)
+        if out_body in group:
+            return True
         sprung = {s.b if s.a == GROUND else s.a for s in part.springs
                   if GROUND in (s.a, s.b)}
         return any(j.kind in ("contact", "touch")
@@ -608,7 +612,7 @@ def followers(design: Design, lib: Library) -> dict[str, Follower]:
         part = mech.cells[c.id]
         term = part.terminals.get(cls.outputs[0])
         net = c.outputs[0]
-        if term is None or term.kind != "translating" or net not in mech.nets:
+        if term is None or term.kind != "translating":
             continue
         body = term.body
         springs = []
@@ -621,9 +625,13 @@ def followers(design: Design, lib: Library) -> dict[str, Follower]:
             continue
         sliders = 1 if index[body].kind == "slider" else 0
         free = True
-        for r in net_rods(mech.nets[net]):
-            owner = mech.cells.get(r.load.split(".", 1)[0])
-            if owner is None or sprung_load(r.load, owner):
+        for r in net_rods(mech.nets[net]) if net in mech.nets else ():  # none: an output
+            oid = r.load.split(".", 1)[0]
+            owner = mech.cells.get(oid)
+            out_term = (owner.terminals.get(lib[nl.cells[oid].cell].outputs[0])
+                        if owner is not None and oid in nl.cells else None)
+            if owner is None or sprung_load(r.load, owner,
+                                            out_term.body if out_term else None):
                 free = False
                 break
             sliders += index[r.load].kind == "slider" if r.load in index else 0
