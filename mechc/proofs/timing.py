@@ -282,13 +282,12 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 if f is None or c.outputs[0] not in switched:
                     continue
                 on = bool(logic[c.outputs[0]][2 * i + 1])
-                here[c.id] = f = {**f, **{k: f.get(directed(k, on), f[k]) for k in DIRECTED}}
+                here[c.id] = {**f, **{k: f.get(directed(k, on), f[k]) for k in DIRECTED}}
                 fo = follow.get(c.id)
                 got = (_follow(fo, ts, fsig[c.id][i * SAMPLES:(i + 1) * SAMPLES], hold)
                        if fo is not None else None)
                 if got is not None:
-                    f["lag_s"] = max(f["lag_s"], got[0])
-                    f["settle_extra_s"] = max(f["settle_extra_s"], got[1])
+                    here[c.id]["follower"] = got
             arrive, settle, path = _paths(nl, "in:" + moving, switched, here)
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
@@ -351,7 +350,8 @@ def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | 
     upstream lags plus the driving cell's own settle extra, or the late landing of a cell timed
     as built upstream passed on; passing every gate's alone-table settle on predicted 26 % and
     82 % late on the random circuits, see docs/performance.md) and the cells on the longest
-    path."""
+    path. A cell's figures carry its direction's lag and settle extra, and ``follower``, its
+    :class:`Follower` model's (used when no late landing reaches its inputs)."""
     arrive: dict[str, float] = {source[3:]: 0.0}
     settle: dict[str, float] = {}
     carried: dict[str, float] = {}
@@ -365,9 +365,15 @@ def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | 
             continue
         a, via = max(came)
         f = figs.get(c.id) or {"lag_s": 0.0, "settle_extra_s": 0.0}
-        arrive[net] = a + f["lag_s"]
         # a cell timed as built (an amplifier) lands late: what follows it settles late too
         late = max((carried[x] for x in c.inputs if x in carried), default=0.0)
+        if "follower" in f and not late:
+            # a follower's own model, when its inputs move as the closed form says (behind
+            # an amplifier they do not: its closed form is a step, its landing is carried)
+            lag, extra = f["follower"]
+            f = {**f, "lag_s": max(f["lag_s"], lag),
+                 "settle_extra_s": max(f["settle_extra_s"], extra)}
+        arrive[net] = a + f["lag_s"]
         settle[net] = max(a + f["settle_extra_s"], late + f["lag_s"])
         if f.get("as_built") or late > 0.0:
             carried[net] = settle[net]
