@@ -110,6 +110,8 @@ def test_follower_rides_its_bound_when_the_spring_is_strong():
     lag, extra = _follow(fo, ts, cf, 0.23)
     assert abs(lag) < 1e-3 and abs(extra) < 1e-3
     assert _follow(fo, ts, cf[::-1], 0.23) is None  # pushed against its spring: not its case
+    t, x = fo.run(ts, cf, 0.23)  # the model itself, not only its shortcut
+    assert np.max(np.abs(x - np.interp(t, ts, cf))) < 1e-3
 
 
 def test_shipped_tables_keep_each_direction_and_the_worse_of_the_two():
