@@ -34,9 +34,10 @@ EXHAUSTIVE_MAX_INPUTS = 10
 MAX_LISTED = 50
 #: states solved per vectorised call (a sweep's chunk, at most): each closed form passes over
 #: its arrays a few dozen times, so a chunk whose arrays stay in the CPU cache between passes
-#: is solved faster per state than a larger one, while the per-call cost of the solver's
-#: Python is spread over enough states. 16384 states are 128 KB per array.
-SOLVE_CHUNK = 16384
+#: is solved faster per state than a larger one, while the solver's per-call Python is spread
+#: over enough states. 8192 states are 64 KB per array: under glibc's 128 KB mmap threshold,
+#: where arrays of a larger chunk can be mapped and unmapped (page faults) on every call.
+SOLVE_CHUNK = 8192
 
 
 def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
