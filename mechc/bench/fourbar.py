@@ -23,6 +23,7 @@ import numpy as np
 from mechc.geometry.circles import branch_of, circle_intersection
 from mechc.ir.mechanism import Body, Joint, Part
 from mechc.physics.closed_form import cos_sin, position, solve
+from mechc.proofs.kinematic import SOLVE_CHUNK
 
 GROUND_LEN, CRANK, COUPLER, ROCKER = 40.0, 10.0, 40.0, 30.0  # mm: Grashof crank-rocker
 
@@ -147,10 +148,9 @@ class PeerResult:
     mechc_reduced_per_s: float = math.nan  # and the checks reduced to their figures
 
 
-# states per vectorised call, cache-sized. A proof's sweep chunks larger (budget // (3 bodies),
-# mechc/proofs/kinematic.py); for this two-lever part 16384 measured ~25% faster and 65536 slower
-# (memory-bound), so 4096 is neither the best nor the worst case.
-CHUNK = 4096
+# states per vectorised call: the chunk a proof's sweep solves at once (at most
+# ``SOLVE_CHUNK``; mechc/proofs/kinematic.py), so the figure times the path a proof runs
+CHUNK = SOLVE_CHUNK
 
 
 def compare(n: int = 200_000, n_step: int = 5_000, repeat: int = 3) -> PeerResult:

@@ -81,9 +81,9 @@ class Paired:
 
 
 def paired(n: int = 200_000, rounds: int = ROUNDS, inner: int = INNER) -> Paired:
-    """mechc's four-bar (in 4096-state chunks, as ``compare``) and pylinkage's numba
-    ``step_fast`` on ``n`` crank positions each, in alternating rounds (CPU seconds, each
-    side's best of ``inner`` calls per round)."""
+    """mechc's four-bar (in chunks of ``CHUNK`` states, the chunk a proof solves at once, as
+    ``compare``) and pylinkage's numba ``step_fast`` on ``n`` crank positions each, in
+    alternating rounds (CPU seconds, each side's best of ``inner`` calls per round)."""
     th = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
     lk = pylinkage_linkage(n)
     lk.step_fast(iterations=100)  # compile

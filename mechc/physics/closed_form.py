@@ -15,12 +15,16 @@ joint kind lives with its kind in ``mechc.parts``.
 
 from __future__ import annotations
 
+import operator
+import weakref
+
 import numpy as np
 
 from mechc.geometry.circles import circle_meeting
 from mechc.ir.mechanism import GROUND, Body, Joint, Part
 from mechc.parts import body_kind, joint_kind
 from mechc.parts.base import (
+    JointKind,
     body_or_ground,
     cross,
     displacement,
@@ -54,22 +58,34 @@ def solve(part: Part, fixed: dict[str, np.ndarray], size: int,
     """Solve every body of ``part`` given the displacements of the bodies in ``fixed``.
 
     ``extra_bodies`` are bodies outside the part (already solved, in ``fixed``) that joints
-    may refer to (e.g. a connector's driver)."""
-    bodies = {b.id: b for b in part.bodies}
-    if extra_bodies:
-        bodies.update(extra_bodies)
+    may refer to (e.g. a connector's driver).
+
+    The order in which bodies are placed, and by which closed form, depends only on which
+    bodies and joints the part has and which are given, never on the values: it is worked out
+    on the first solve and replayed after (:class:`_Plan`), as a proof solves each part once
+    per chunk of states."""
+    plan = _plan_of(part, fixed, extra_bodies)
+    bodies = plan.bodies if plan is not None else _bodies(part, extra_bodies)
     poses = Poses()
     for bid, u in fixed.items():
         b = bodies[bid]
         kind = body_kind(b.kind)
+        if not kind.input_terminal:
+            raise KinematicsError(f"{bid}: a free {b.kind} cannot be an input terminal")
         if isinstance(u, np.ndarray) and u.dtype == np.float64 and u.shape == (size,):
             u = u.copy()
         else:
             u = np.broadcast_to(np.asarray(u, dtype=float), (size,)).copy()
         getattr(poses, kind.coordinate)[bid] = u
         poses.bad[bid] = np.zeros(size, dtype=bool)
-        if not kind.input_terminal:
-            raise KinematicsError(f"{bid}: a free {b.kind} cannot be an input terminal")
+    if plan is not None:
+        for step, args in plan.steps:
+            if not step(*args, poses, size):  # the structure is the plan's: cannot happen
+                raise AssertionError(f"{part}: a planned closed form did not apply")
+        for violation, j, a, b in plan.checks:
+            _mark_violation(violation(j, a, b, poses, size, 1e-6), a, b, poses)
+        return poses
+    steps: list[tuple] = []
     todo = [b for b in part.bodies if b.id not in fixed]
     by_body: dict[str, list[Joint]] = {}
     for j in part.joints:
@@ -78,37 +94,61 @@ def solve(part: Part, fixed: dict[str, np.ndarray], size: int,
     while todo:
         progress = False
         for b in list(todo):
-            if poses.known(b.id) or _try_solve(part, b, bodies, by_body, poses, size):
+            if poses.known(b.id):
+                todo.remove(b)
+                progress = True
+                continue
+            step = _try_solve(part, b, bodies, by_body, poses, size)
+            if step is not None:
+                steps.append(step)
                 todo.remove(b)
                 progress = True
         if not progress:
             raise KinematicsError(
                 "cannot determine " + ", ".join(b.id for b in todo)
                 + " from the geometry (no joint or limit drives them)")
-    _check_consistency(part, bodies, poses, size)
+    checks = _consistency_checks(part, bodies, poses)
+    for violation, j, a, b in checks:
+        _mark_violation(violation(j, a, b, poses, size, 1e-6), a, b, poses)
+    _keep_plan(part, fixed, extra_bodies, _Plan(tuple(part.bodies), tuple(part.joints),
+                                                tuple((extra_bodies or {}).values()), bodies,
+                                                steps, checks))
     return poses
 
 
 def _try_solve(part, b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
-               size: int) -> bool:
+               size: int) -> tuple | None:
+    """Place ``b`` by the first closed form that applies; the step taken, ``(function, its
+    arguments before poses and size)``, or None if none applies yet."""
     joints = by_body.get(b.id, [])
     # 1) bilateral joints to an already known body
     for j in joints:
         other = j.b if j.a == b.id else j.a
         if not poses.known(other):
             continue
-        if joint_kind(j.kind).solve(j, b, body_or_ground(bodies, other), poses, size):
-            return True
+        step = (joint_kind(j.kind).solve, (j, b, body_or_ground(bodies, other)))
+        if step[0](*step[1], poses, size):
+            return step
     kind = body_kind(b.kind)
-    if kind.dyad and _try_dyad(b, bodies, by_body, poses, size):
-        return True
+    if kind.dyad:
+        step = (_try_dyad, (b, bodies, by_body))
+        if _try_dyad(b, bodies, by_body, poses, size):
+            return step
     if not kind.held_by_contacts:
-        return False
+        return None
     # 2) a slider held only by contacts: all the other bodies must be known
     # contacts that position this body (those it drives are checked afterwards)
     contacts = [j for j in joints if joint_kind(j.kind).one_sided and j.driven in (b.id, None)]
     if not contacts or any(not poses.known(j.b if j.a == b.id else j.a) for j in contacts):
-        return False
+        return None
+    step = (_held_by_contacts, (part, b, bodies, contacts))
+    return step if _held_by_contacts(part, b, bodies, contacts, poses, size) else None
+
+
+def _held_by_contacts(part, b: Body, bodies, contacts: list[Joint], poses: Poses,
+                      size: int) -> bool:
+    """A slider held by one-sided contacts against known bodies, pushed by its spring to the
+    nearest limit on its side."""
     sign = spring_sign(part, b)
     if sign == 0:
         raise KinematicsError(f"{b.id}: held only by contacts but no spring pushes it")
@@ -187,16 +227,84 @@ def _try_dyad(b: Body, bodies, by_body: dict[str, list[Joint]], poses: Poses,
     return False
 
 
-def _check_consistency(part: Part, bodies, poses: Poses, size: int, tol: float = 1e-6) -> None:
-    """Contacts must not be penetrated and redundant bilateral joints must close; states where
-    they do not are marked bad on the joint's bodies (the mechanism binds there)."""
+def _consistency_checks(part: Part, bodies, poses: Poses) -> list[tuple]:
+    """The joints whose kind checks them once both bodies are solved (contacts must not be
+    penetrated, redundant bilateral joints must close), as ``(violation, joint, a, b)``."""
+    out = []
     for j in part.joints:
         a, b = body_or_ground(bodies, j.a), body_or_ground(bodies, j.b)
         if (a is not None and not poses.known(a.id)) or (b is not None and not poses.known(b.id)):
             continue
-        viol = joint_kind(j.kind).violation(j, a, b, poses, size, tol)
-        if viol is None:
-            continue
-        for x in (a, b):
-            if x is not None:
-                poses.mark(x.id, viol)
+        kind = joint_kind(j.kind)
+        if getattr(kind.violation, "__func__", None) is not _NO_CHECK:  # it checks something
+            out.append((kind.violation, j, a, b))
+    return out
+
+
+def _mark_violation(viol: np.ndarray | None, a: Body | None, b: Body | None,
+                    poses: Poses) -> None:
+    """States where a joint's check fails are marked bad on its bodies (the mechanism binds
+    there)."""
+    if viol is None:
+        return
+    for x in (a, b):
+        if x is not None:
+            poses.mark(x.id, viol)
+
+
+_NO_CHECK = JointKind.violation.__func__  # the default: nothing to check
+
+
+class _Plan:
+    """How a part was solved for one set of given bodies: the bodies and joints it had (by
+    identity: a part whose lists were changed is planned again), the id -> body table, each
+    step (a closed form and the arguments it was called with) and each joint check."""
+
+    __slots__ = ("part_bodies", "part_joints", "extra", "bodies", "steps", "checks")
+
+    def __init__(self, part_bodies, part_joints, extra, bodies, steps, checks):
+        self.part_bodies, self.part_joints, self.extra = part_bodies, part_joints, extra
+        self.bodies, self.steps, self.checks = bodies, steps, checks
+
+
+#: id(part) -> (weak reference to the part, {(given body ids, extra body ids): plan}); an entry
+#: goes with its part
+_PLANS: dict[int, tuple[weakref.ref, dict]] = {}
+
+
+def _plan_key(fixed, extra_bodies) -> tuple:
+    return tuple(fixed), tuple(extra_bodies) if extra_bodies else ()
+
+
+def _plan_of(part: Part, fixed, extra_bodies) -> _Plan | None:
+    """The part's plan for these given bodies, if it still has the bodies and joints it was
+    made with."""
+    entry = _PLANS.get(id(part))
+    if entry is None or entry[0]() is not part:
+        return None
+    plan = entry[1].get(_plan_key(fixed, extra_bodies))
+    if plan is None or not (_same(plan.part_bodies, part.bodies)
+                            and _same(plan.part_joints, part.joints)
+                            and _same(plan.extra, (extra_bodies or {}).values())):
+        return None
+    return plan
+
+
+def _same(kept: tuple, now) -> bool:
+    return len(kept) == len(now) and all(map(operator.is_, kept, now))
+
+
+def _keep_plan(part: Part, fixed, extra_bodies, plan: _Plan) -> None:
+    key = id(part)
+    entry = _PLANS.get(key)
+    if entry is None or entry[0]() is not part:
+        ref = weakref.ref(part, lambda _, key=key: _PLANS.pop(key, None))
+        entry = _PLANS[key] = (ref, {})
+    entry[1][_plan_key(fixed, extra_bodies)] = plan
+
+
+def _bodies(part: Part, extra_bodies) -> dict[str, Body]:
+    bodies = {b.id: b for b in part.bodies}
+    if extra_bodies:
+        bodies.update(extra_bodies)
+    return bodies

@@ -32,6 +32,12 @@ from mechc.proofs.trace import TraceRecorder
 
 EXHAUSTIVE_MAX_INPUTS = 10
 MAX_LISTED = 50
+#: states solved per vectorised call (a sweep's chunk, at most): each closed form passes over
+#: its arrays a few dozen times, so a chunk whose arrays stay in the CPU cache between passes
+#: is solved faster per state than a larger one, while the solver's per-call Python is spread
+#: over enough states. 8192 states are 64 KB per array: under glibc's 128 KB mmap threshold,
+#: where arrays of a larger chunk can be mapped and unmapped (page faults) on every call.
+SOLVE_CHUNK = 8192
 
 
 def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
@@ -83,7 +89,7 @@ def sweep(design: Design, lib: Library, samples: int = 21, seed: int = 0,
             chosen = {**dr.coverage(), "random_changes": sample, "random_states": sample}
     types = {c.id: c.cell for c in design.netlist.cells.values()}
     n_bodies = max(1, len(mech.body_index()))
-    chunk = max(64, budget // (3 * n_bodies))
+    chunk = max(64, min(SOLVE_CHUNK, budget // (3 * n_bodies)))
     total_states = rest_bits.shape[1] + len(e_k) * samples
     done = [0]
 
