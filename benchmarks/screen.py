@@ -250,6 +250,7 @@ def chart(rows: list[dict], path: Path) -> None:
                 ha="center", va="bottom", fontsize=7)
     ax.set_xticks(x, [r["circuit"] for r in rows], rotation=20, fontsize=8)
     ax.set_yscale("log")
+    ax.set_ylim(top=max(dyn + scr) * 12)  # room for the labels above the tallest bars
     ax.set_ylabel("seconds, wall clock (log)")
     ax.set_title("screened vs whole dynamic proof (changes in pymunk / all; speed-up; "
                  "(speed-up on 1 process each))", fontsize=10)
