@@ -111,6 +111,8 @@ HEAVY_KG = 0.09
 SOLVER_FACTOR = 6.0
 #: Per-change decisions kept in the report.
 MAX_LISTED = 200
+#: Failed calibration checks listed in the report (all are counted).
+MAX_FAILED = 50
 
 
 @engine("screened", "combinational")
@@ -222,7 +224,8 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
         "held_margin_fraction": held_margin, "joint_headroom": JOINT_HEADROOM,
         "contact_headroom": CONTACT_HEADROOM, "stall_factor": SOLVER_FACTOR,
         "held_room_fraction": round(room, 6),
-        "calibration": bad or "passed", "fell_back": fell_back, "reasons": reasons,
+        "calibration": bad[:MAX_FAILED] or "passed", "calibration_failures": len(bad),
+        "fell_back": fell_back, "reasons": reasons,
         "decisions": decisions[:MAX_LISTED]}
     rep.level = "screened"
     rep.cases = len(pairs)
