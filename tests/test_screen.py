@@ -31,6 +31,8 @@ from mechc.proofs.screen import (
     SETTLE_MARGIN,
     SOLVER_FACTOR,
     calibrate,
+    calibration_failures,
+    concerned,
     decide,
     held_by_logic,
     prove_screened,
@@ -136,6 +138,85 @@ def test_calibration_flags_each_kind_of_disagreement():
     dec[0]["heavy"] = True
     assert bad(max_violation_mm=st.violation_limit * 0.99,
                max_penetration_mm=st.penetration_limit * 0.99, settle_time_s=late * 1.5) == []
+
+
+def test_calibration_failures_name_the_change_and_check():
+    st = DynSettings()
+    dec = [{"moving": "a", "to": 1}, {"moving": "b", "to": 0}]
+    timed = [{"nets_settle_s": 0.1, "closed_form_swing": {"z": 0.0}}] * 2
+    recs = [_rec(max_penetration_mm=st.penetration_limit), _rec(held_deviation={"z": 0.02})]
+    got = calibration_failures(dec, timed, [0, 1], recs, st, 0.025, 0.05, 20.0)
+    assert [(f["change"], f["check"], f.get("output")) for f in got] == \
+        [(0, "contact", None), (1, "held", "z")]
+
+
+def test_a_failure_concerns_what_its_change_vouched_for():
+    """A failing change takes the vouching only from the cleared changes that share a (cell
+    kind, direction) with it, move its input, or (a held output that moved too far) must
+    hold that output; changes that ran are never listed again."""
+    dec = [{"moving": "a", "route": "dynamic", "holds": []},
+           {"moving": "b", "route": "timing", "holds": []},          # shares kind 0 rising
+           {"moving": "a", "route": "timing", "holds": []},          # same moving input
+           {"moving": "c", "route": "timing", "holds": ["z"]},       # holds z
+           {"moving": "c", "route": "timing", "holds": []},          # kind 0 falling: not
+           {"moving": "b", "route": "dynamic", "holds": ["z"]}]      # ran already
+    keys = [{"0:1", "1:0"}, {"0:1"}, set(), {"2:1"}, {"0:0"}, {"0:1"}]
+    assert concerned({"change": 0, "check": "joint"}, dec, keys) == [1, 2]
+    assert concerned({"change": 0, "check": "held", "output": "z"}, dec, keys) == [1, 2, 3]
+
+
+def test_a_failed_calibration_runs_only_the_changes_it_concerns(monkeypatch):
+    """One witness of the sorter made to fail its calibration: the cleared changes it vouched
+    for run in pymunk too, they are checked in turn, and every other change stays cleared
+    (before, every change ran)."""
+    from mechc.proofs import screen
+
+    d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+    _, _, dec0 = decide(d, d.spec, LIB, ProofSettings(), dyn_settings(d))
+    keys = [set(x["kinds"]) for x in dec0]
+    first = [i for i, x in enumerate(dec0) if x["route"] == "dynamic"]
+    w = next(i for i in first if keys[i])
+    fake = {"change": w, "check": "settle", "text": f"change {w}: made to fail"}
+    want = set(concerned(fake, dec0, keys))
+    assert want and len(want) < len(dec0) - len(first)  # the test means something
+    real = screen.calibration_failures
+    seen: list[list[int]] = []
+
+    def one_failure(decisions, timed, run, record, *a):
+        seen.append(list(run))
+        got = real(decisions, timed, run, record, *a)
+        return got + [fake] if len(seen) == 1 else got
+
+    monkeypatch.setattr(screen, "calibration_failures", one_failure)
+    rep = prove_screened(d, d.spec, LIB, ProofSettings())
+    sc = rep.figures["screen"]
+    ran = {i for i, x in enumerate(sc["decisions"]) if x["route"] == "dynamic"}
+    assert ran == set(first) | want
+    assert seen[1] == sorted(want)  # the changes that fell back were checked in turn
+    assert sc["fell_back"] == len(want) and sc["dynamic"] == len(ran)
+    assert rep.cases == 31 and rep.passed
+    assert all(any(w.startswith("calibration failed") for w in sc["decisions"][i]["why"])
+               for i in want)
+
+
+@pytest.mark.slow
+def test_witnesses_failing_for_real_leave_nothing_they_vouched_for_cleared(monkeypatch):
+    """No headroom at all: every change that ran fails its joint check in pymunk. The
+    screened proof then agrees with the dynamic one change by change, and no change left
+    cleared shares a (cell kind, direction) or a moving input with a change that ran."""
+    from mechc.proofs import screen
+
+    monkeypatch.setattr(screen, "JOINT_HEADROOM", 1.0)
+    d = compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+    sc, _full = _same_as_dynamic(d)
+    assert sc["calibration"] != "passed" and sc["fell_back"] > 0
+    assert sc["cleared_by_timing"] > 0  # what no failing change vouched for stays cleared
+    dec = sc["decisions"]
+    ran = [x for x in dec if x["route"] == "dynamic" and not x["heavy"]]
+    for x in dec:
+        if x["route"] == "timing":
+            assert not any(set(x["kinds"]) & set(r["kinds"]) or x["moving"] == r["moving"]
+                           for r in ran)
 
 
 def test_a_heavy_change_runs_in_pymunk_and_witnesses_nothing(monkeypatch):

@@ -39,8 +39,16 @@ checked on the changes that ran (the *calibration*): their measured settle no la
 prediction by more than the model's error, held outputs' excess over the closed form within
 half the least room the cleared changes leave on theirs (the tolerance less their closed
 form's move, at least the held margin), joints and contacts within their headroom, the
-servo's lag within the stall limit by ``SOLVER_FACTOR``. If any check fails every change
-runs in pymunk. A design that holds state (its rest depends on the past), a sequential
+servo's lag within the stall limit by ``SOLVER_FACTOR``. A change that fails a check
+vouches for nothing: every cleared change it concerns runs in pymunk, namely those that
+switch one of its (cell kind, direction) (it witnessed that kind for them: the headrooms
+bound a cleared change only through changes that ran, switched its kinds alike and
+passed), those moving the same input (its driver and the cells it moves
+without switching them; a change that switches no cell has no other witness), and, for a
+held output that moved too far, every cleared change that must hold that output. The
+changes that fall back are checked in turn, and so on until no check fails: a cleared
+change is left cleared only when every change that ran and shares a kind or its moving
+input passed. A design that holds state (its rest depends on the past), a sequential
 design, a run asked for a pose trace or for an accuracy: the whole dynamic proof, and the
 report says so.
 """
@@ -103,6 +111,8 @@ HEAVY_KG = 0.09
 SOLVER_FACTOR = 6.0
 #: Per-change decisions kept in the report.
 MAX_LISTED = 200
+#: Failed calibration checks listed in the report (all are counted).
+MAX_FAILED = 50
 
 
 @engine("screened", "combinational")
@@ -163,22 +173,44 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     # the room the cleared changes leave on their held outputs (at least held_margin each)
     room = min((d["held_room"] for d in decisions if d["route"] == "timing"),
                default=settings.tolerance)
-    bad = calibrate(decisions, timed, run, record, st, room, settings.tolerance,
-                    design.mechanism.ctx.stroke)
-    if bad:
-        rest = [i for i, d in enumerate(decisions) if d["route"] == "timing"]
-        for i in rest:
+    stroke = design.mechanism.ctx.stroke
+    keys = [set(d["kinds"]) for d in decisions]
+    failures = calibration_failures(decisions, timed, run, record, st, room,
+                                    settings.tolerance, stroke)
+    bad = [f["text"] for f in failures]
+    fell_back = 0
+    while failures:
+        # a failing change vouches for nothing: the cleared changes it concerns run, and
+        # they are checked in turn (their failures may concern more)
+        rest: dict[int, str] = {}
+        for f in failures:
+            for i in concerned(f, decisions, keys):
+                rest.setdefault(i, f["text"])
+        for i, text in rest.items():
             decisions[i]["route"] = "dynamic"
-            decisions[i]["why"].append("calibration failed: " + bad[0])
-        if rest:
-            more = prove_dynamic(design, spec, lib, st, progress=progress, only=rest, **kw)
-            rep = _merge(rep, more)
-        run = sorted(run + rest)
+            decisions[i]["why"].append("calibration failed: " + text)
+        if not rest:
+            break
+        more_rec: list[dict] = []
+        again = sorted(rest)
+        more = prove_dynamic(design, spec, lib, st, progress=progress, only=again,
+                             record=more_rec, **kw)
+        for i, r in zip(again, more_rec):
+            decisions[i]["measured_settle_s"] = (round(r["settle_time_s"] + st.move_time, 5)
+                                                 if math.isfinite(r["settle_time_s"]) else None)
+        rep = _merge(rep, more)
+        run = sorted(run + again)
+        fell_back += len(again)
+        failures = calibration_failures(decisions, timed, again, more_rec, st, room,
+                                        settings.tolerance, stroke)
+        bad += [f["text"] for f in failures]
     cleared = len(pairs) - len(run)
     text = (f"screen: {len(run)} of {len(pairs)} changes ran in pymunk, {cleared} cleared by "
             f"timing (cleared when predicted settle x {1 + SETTLE_MARGIN:g} <= "
             f"{budget:.3f} s, i.e. slack >= {SETTLE_MARGIN:.0%} of the settle)"
-            + (f"; calibration failed ({bad[0]}): every change ran" if bad else ""))
+            + (f"; calibration failed ({bad[0]}"
+               + (f" and {len(bad) - 1} more" if len(bad) > 1 else "")
+               + f"): {fell_back} changes it concerned ran too" if bad else ""))
     reasons: dict[str, int] = {}
     for d in decisions:
         if d["route"] == "dynamic":
@@ -192,7 +224,8 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
         "held_margin_fraction": held_margin, "joint_headroom": JOINT_HEADROOM,
         "contact_headroom": CONTACT_HEADROOM, "stall_factor": SOLVER_FACTOR,
         "held_room_fraction": round(room, 6),
-        "calibration": bad or "passed", "reasons": reasons,
+        "calibration": bad[:MAX_FAILED] or "passed", "calibration_failures": len(bad),
+        "fell_back": fell_back, "reasons": reasons,
         "decisions": decisions[:MAX_LISTED]}
     rep.level = "screened"
     rep.cases = len(pairs)
@@ -244,6 +277,7 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
             why.append(f"slack {slack:.4f} s < {SETTLE_MARGIN:.0%} of the predicted settle "
                        f"{rec['nets_settle_s']:.4f} s")
         room = settings.tolerance  # what the dynamics may add on its held outputs
+        holds: list[str] = []
         for o in spec.outputs:
             want, was = int(after[o][i]), int(before[o][i])
             end = rec["closed_form_end"].get(o)
@@ -253,6 +287,7 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
                 why.append(f"{o}: closed-form rest {abs(end - want):.4f} from {want} (cleared "
                            f"within {settings.tolerance - REST_MARGIN:.4f})")
             if want == was:
+                holds.append(o)
                 if not held_ok[o][i]:
                     why.append(f"{o} must hold: a hazard is possible (ternary simulation)")
                 dev = abs(end - want) + rec["closed_form_swing"][o]
@@ -264,7 +299,7 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
                           "route": "dynamic" if why else "timing", "why": why,
                           "predicted_settle_s": round(rec["nets_settle_s"], 5),
                           "slack_s": round(slack, 5), "heavy": bool(heavy),
-                          "held_room": round(room, 6)})
+                          "held_room": round(room, 6), "holds": holds})
     # the cleared changes' cells (kind, direction) each switched by a change run in pymunk (a
     # heavy change witnesses nothing: its stretch is its own)
     covered = {(kind[c], d) for dec, rec in zip(decisions, timed)
@@ -281,43 +316,76 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
         decisions[best]["why"].append(f"witness: the first run of {len(got)} (cell kind, "
                                       "direction) the cleared changes switch")
         need_cover -= got
+    # each change's (cell kind, direction) as short ids: what a calibration failure concerns
+    ids = {k: j for j, k in enumerate(sorted(set(kind.values())))}
+    for dec, rec in zip(decisions, timed):
+        dec["kinds"] = sorted(f"{ids[kind[c]]}:{int(d)}" for c, d in rec["switched"].items())
     return pairs, timed, decisions
 
 
 def calibrate(decisions: list[dict], timed: list[dict], run: list[int], record: list[dict],
               st: DynSettings, held_margin: float, tolerance: float, stroke: float
               ) -> list[str]:
-    """What the changes run in pymunk say against the screen's model (empty: nothing).
-    ``held_margin``: the least room the cleared changes leave the dynamics on an output that
-    must hold (the tolerance less its closed form's move); a held output of a change that ran
-    must have moved beyond its closed form by at most half that."""
-    bad: list[str] = []
+    """What the changes run in pymunk say against the screen's model (empty: nothing), as
+    text; :func:`calibration_failures` says which change and check each one is."""
+    return [f["text"] for f in calibration_failures(decisions, timed, run, record, st,
+                                                    held_margin, tolerance, stroke)]
+
+
+def calibration_failures(decisions: list[dict], timed: list[dict], run: list[int],
+                         record: list[dict], st: DynSettings, held_margin: float,
+                         tolerance: float, stroke: float) -> list[dict]:
+    """Each disagreement of a change run in pymunk with the screen's model: ``change`` (its
+    index), ``check`` (``joint``, ``contact``, ``stall``, ``settle`` or ``held``), ``text``
+    and, for ``held``, the ``output``. ``held_margin``: the least room the cleared changes
+    leave the dynamics on an output that must hold (the tolerance less its closed form's
+    move); a held output of a change that ran must have moved beyond its closed form by at
+    most half that."""
+    bad: list[dict] = []
     for i, r in zip(run, record):
         where = f"change {i} ({decisions[i]['moving']} to {decisions[i]['to']})"
         if decisions[i].get("heavy"):
             continue  # outside the model (stretch, settle): the dynamic proof judges it alone
+
+        def fail(check: str, text: str, i: int = i, where: str = where, **more) -> None:
+            bad.append({"change": i, "check": check, "text": f"{where}: {text}", **more})
+
         if r["max_violation_mm"] > (1 - JOINT_HEADROOM) * st.violation_limit or \
                 not math.isfinite(r["max_violation_mm"]):
-            bad.append(f"{where}: joint stretch {r['max_violation_mm']:.4g} mm leaves less "
-                       f"than {JOINT_HEADROOM:.0%} of the limit {st.violation_limit:g} mm")
+            fail("joint", f"joint stretch {r['max_violation_mm']:.4g} mm leaves less than "
+                 f"{JOINT_HEADROOM:.0%} of the limit {st.violation_limit:g} mm")
         if r["max_penetration_mm"] > (1 - CONTACT_HEADROOM) * st.penetration_limit:
-            bad.append(f"{where}: contact overrun {r['max_penetration_mm']:.4g} mm leaves less "
-                       f"than {CONTACT_HEADROOM:.0%} of the limit {st.penetration_limit:g} mm")
+            fail("contact", f"contact overrun {r['max_penetration_mm']:.4g} mm leaves less "
+                 f"than {CONTACT_HEADROOM:.0%} of the limit {st.penetration_limit:g} mm")
         lag = r.get("servo_lag_end_mm", 0.0)
         if lag * SOLVER_FACTOR > tolerance * stroke:
-            bad.append(f"{where}: input ended {lag:.4g} mm short, within {SOLVER_FACTOR:g}x "
-                       f"of the stall limit {tolerance * stroke:.4g} mm")
+            fail("stall", f"input ended {lag:.4g} mm short, within {SOLVER_FACTOR:g}x of the "
+                 f"stall limit {tolerance * stroke:.4g} mm")
         s = r["settle_time_s"]
         pred = timed[i]["nets_settle_s"]
         if not math.isfinite(s) or (s > 0 and s + st.move_time > pred * (1 + MODEL_ERROR)):
-            bad.append(f"{where}: settled {s + st.move_time:.4f} s, predicted {pred:.4f} s "
-                       f"(model error bound {MODEL_ERROR:.0%})")
+            fail("settle", f"settled {s + st.move_time:.4f} s, predicted {pred:.4f} s (model "
+                 f"error bound {MODEL_ERROR:.0%})")
         for o, dev in r.get("held_deviation", {}).items():
             cf = timed[i]["closed_form_swing"].get(o, 0.0)
             if dev - cf > held_margin / 2:
-                bad.append(f"{where}: held output {o} moved {dev:.4f}, closed form {cf:.4f} "
-                           f"(margin {held_margin:.4f})")
+                fail("held", f"held output {o} moved {dev:.4f}, closed form {cf:.4f} (margin "
+                     f"{held_margin:.4f})", output=o)
     return bad
+
+
+def concerned(failure: dict, decisions: list[dict], keys: list[set]) -> list[int]:
+    """The cleared changes a calibration failure takes the vouching from: those sharing a
+    (cell kind, direction) with the failing change (what it witnessed), those moving the same
+    input (its driver and the cells it feeds without switching them: a change that switches
+    no cell has no witness but these), and for a held output that moved too far, every
+    cleared change that must hold that output."""
+    w = failure["change"]
+    mine, moving = keys[w], decisions[w]["moving"]
+    out = failure.get("output")
+    return [i for i, d in enumerate(decisions) if d["route"] == "timing"
+            and (keys[i] & mine or d["moving"] == moving
+                 or (out is not None and out in d.get("holds", [])))]
 
 
 def _merge(a: ProofReport, b: ProofReport) -> ProofReport:
