@@ -340,19 +340,20 @@ def predict_changes(design: Design, lib: Library, names: list[str],
 def _leads(design: Design, lib: Library, push: dict[str, Pusher], switched: set[str],
            arrive: dict[str, float], figs: dict[str, dict | None], loads: dict[str, float],
            poses, size: int, sl: slice, ts: np.ndarray) -> dict[str, np.ndarray]:
-    """Per switched net that a pushed output leads (:class:`Pusher`): the times its closed
-    form's samples are reached (earlier than ``ts``). The lead starts at a cell pushed against
-    its springs whose inputs arrive when the closed form says (no lag, nothing timed as built
-    upstream) and passes to every cell all of whose switching inputs it leads (they follow
-    their inputs' positions; a cell with one switching input that it does not lead is left
-    alone)."""
+    """Per switched net that a pushed output leads (:class:`Pusher`) and that lands on a
+    follower's stop: the times its closed form's samples are reached (earlier than ``ts``).
+    The lead starts at a cell pushed against its springs whose inputs arrive when the closed
+    form says (no lag, nothing timed as built upstream) and passes to every cell that moves
+    with its inputs and all of whose switching inputs it leads (a cell with a switching input
+    that it does not lead is left alone)."""
     mech, nl = design.mechanism, design.netlist
     index = mech.body_index()
     head_of: dict[str, str] = {}
     warp: dict[str, np.ndarray] = {}
-    known: dict[str, bool] = {}
+    known: dict[str, str] = {}
+    landed: set[str] = set()  # nets a follower after the head lands on its own stop
 
-    def moves_with(cid: str) -> bool:
+    def moves_with(cid: str) -> str:
         if cid not in known:
             known[cid] = _moves_with(design, lib, cid, switched, loads, poses, size, sl, ts)
         return known[cid]
@@ -366,9 +367,12 @@ def _leads(design: Design, lib: Library, push: dict[str, Pusher], switched: set[
             continue
         heads = {head_of.get(x) for x in ins}
         if len(heads) == 1 and None not in heads:
-            if moves_with(c.id):
+            how = moves_with(c.id)
+            if how:
                 head_of[net] = heads.pop()
                 warp[net] = warp[ins[0]]
+                if how == "follows" or all(x in landed for x in ins):
+                    landed.add(net)
             continue
         pu = push.get(c.id)
         f = figs.get(c.id) or {}
@@ -389,31 +393,36 @@ def _leads(design: Design, lib: Library, push: dict[str, Pusher], switched: set[
             continue
         head_of[net] = c.id
         warp[net] = tw
-    return warp
+    # a pushed body hits its stop at speed and bounces off it (the whole scene: a 0.12 kg OR
+    # bar 2 % of stroke past its end, settling no earlier than its closed form): only a net
+    # that a follower downstream lands on a stop of its own, held there by its spring, takes
+    # the lead's earlier settle
+    return {net: tw for net, tw in warp.items() if net in landed}
 
 
 def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
-                loads: dict[str, float], poses, size: int, sl: slice, ts: np.ndarray) -> bool:
+                loads: dict[str, float], poses, size: int, sl: slice, ts: np.ndarray) -> str:
     """Whether a switching cell's output moves with its inputs all along the move, so a lead
-    of its inputs is its own: its springs store energy as it switches (its inputs push it), or
+    of its inputs is its own: ``"pushed"`` when its springs store energy as it switches (its
+    inputs push it), ``"follows"`` when
     they (with those of the loads it drives down the path) give it back fast enough to
     accelerate the cell's bodies and what it drives as the closed form asks (it keeps up; one
-    that falls behind does not follow a lead either)."""
+    that falls behind does not follow a lead either: ``""``)."""
     mech, nl = design.mechanism, design.netlist
     if cid not in mech.cells or lib[nl.cells[cid].cell].stateful:
-        return False
+        return ""
     index = mech.body_index()
     part = mech.cells[cid]
     term = part.terminals.get(lib[nl.cells[cid].cell].outputs[0])
     if term is None or term.body not in index:
-        return False
+        return ""
     cf = np.broadcast_to(np.asarray(signal_of(term, index[term.body], poses), dtype=float),
                          (size,))[sl]
     if abs(float(cf[-1] - cf[0])) < 0.5:
-        return False
+        return ""
     energy = _spring_energy(mech, part.springs, poses, size, sl)
     if energy[-1] > energy[0]:
-        return True  # pushed by its inputs
+        return "pushed"  # by its inputs
     # moved by springs: its own and those of what it drives down the path (a load's spring
     # that presses on its input pushes this output along through the net)
     index = mech.body_index()
@@ -428,7 +437,7 @@ def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
     step = np.diff(y)
     ok = step > 1e-9
     if not ok.any():
-        return False
+        return ""
     S = mech.ctx.stroke
     # a one-dimensional run of it behind its inputs: it must be back on them by the middle
     # of the move, where the input starts to decelerate (a lead can only start there)
@@ -447,7 +456,7 @@ def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
             x, v = float(h[i]), (float(h[i]) - float(h[i - 1])) / COAST_DT
         if t[i] >= 0.5 * ts[-1]:
             gap = max(gap, float(h[i]) - x)
-    return gap <= SETTLED
+    return "follows" if gap <= SETTLED else ""
 
 
 def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
