@@ -250,6 +250,7 @@ def predict_changes(design: Design, lib: Library, names: list[str],
             for cid, tab in tables.items()}
     follow = followers(design, lib)
     push = pushers(design, lib)
+    parts = _Parts.of(design) if push else None
     hold = st.move_time + st.settle_time
     out: list[dict] = []
     frac = np.linspace(0.0, 1.0, SAMPLES)
@@ -292,8 +293,9 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                     here[c.id]["follower"] = got
             arrive, settle, path = _paths(nl, "in:" + moving, switched, here)
             sl = slice(i * SAMPLES, (i + 1) * SAMPLES)
-            lead = _leads(design, lib, push, switched, arrive, here, loads, poses,
-                          len(chunk) * SAMPLES, sl, ts)
+            lead = (_leads(design, lib, parts, push, switched, arrive, here, loads, poses,
+                           len(chunk) * SAMPLES, sl, ts, set(nl.outputs.values()))
+                    if push else {})
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
             if detail:
@@ -337,25 +339,47 @@ def predict_changes(design: Design, lib: Library, names: list[str],
     return out
 
 
-def _leads(design: Design, lib: Library, push: dict[str, Pusher], switched: set[str],
+@dataclass
+class _Parts:
+    """What the lead model reads of the mechanism on every change, gathered once: the bodies
+    by id and each cell's own bodies (not the input sliders its nets' rods drive)."""
+
+    index: dict
+    own: dict[str, list[str]]
+
+    @classmethod
+    def of(cls, design: Design) -> _Parts:
+        mech = design.mechanism
+        index = mech.body_index()
+        ins = {r.load for p in mech.nets.values() for r in net_rods(p)}
+        own = {cid: [b.id for b in part.bodies if b.id not in ins]
+               for cid, part in mech.cells.items()}
+        return cls(index, own)
+
+
+def _leads(design: Design, lib: Library, parts: _Parts, push: dict[str, Pusher],
+           switched: set[str],
            arrive: dict[str, float], figs: dict[str, dict | None], loads: dict[str, float],
-           poses, size: int, sl: slice, ts: np.ndarray) -> dict[str, np.ndarray]:
-    """Per switched net that a pushed output leads (:class:`Pusher`) and that lands on a
-    follower's stop: the times its closed form's samples are reached (earlier than ``ts``).
+           poses, size: int, sl: slice, ts: np.ndarray, wanted: set[str]
+           ) -> dict[str, np.ndarray]:
+    """Per switched net of ``wanted`` that a pushed output leads (:class:`Pusher`) and that
+    lands on a follower's stop: the times its closed form's samples are reached (earlier than
+    ``ts``).
     The lead starts at a cell pushed against its springs whose inputs arrive when the closed
     form says (no lag, nothing timed as built upstream) and passes to every cell that moves
     with its inputs and all of whose switching inputs it leads (a cell with a switching input
     that it does not lead is left alone)."""
     mech, nl = design.mechanism, design.netlist
-    index = mech.body_index()
+    index = parts.index
     head_of: dict[str, str] = {}
-    warp: dict[str, np.ndarray] = {}
+    cfs: dict[str, np.ndarray] = {}
     known: dict[str, str] = {}
     landed: set[str] = set()  # nets a follower after the head lands on its own stop
 
     def moves_with(cid: str) -> str:
         if cid not in known:
-            known[cid] = _moves_with(design, lib, cid, switched, loads, poses, size, sl, ts)
+            known[cid] = _moves_with(design, lib, parts, cid, switched, loads, poses, size,
+                                     sl, ts)
         return known[cid]
 
     for c in nl.topo_cells():
@@ -370,7 +394,6 @@ def _leads(design: Design, lib: Library, push: dict[str, Pusher], switched: set[
             how = moves_with(c.id)
             if how:
                 head_of[net] = heads.pop()
-                warp[net] = warp[ins[0]]
                 if how == "follows" or all(x in landed for x in ins):
                     landed.add(net)
             continue
@@ -383,24 +406,32 @@ def _leads(design: Design, lib: Library, push: dict[str, Pusher], switched: set[
         cf = np.broadcast_to(np.asarray(cf, dtype=float), (size,))[sl]
         if abs(float(cf[-1] - cf[0])) < 0.5:
             continue
-        own = _spring_energy(mech, pu.springs, poses, size, sl)
+        own = _spring_energy(index, pu.springs, poses, size, sl)
         if own[-1] <= own[0]:
             continue  # its spring moves it this way: not pushed
-        mass, springs, sliders = _train(design, lib, pu, switched, loads, moves_with)
-        energy = _spring_energy(mech, springs, poses, size, sl)
-        tw = _coast(ts, cf, energy, mass, mech.ctx.friction * sliders, mech.ctx.stroke)
-        if tw is None:
-            continue
         head_of[net] = c.id
-        warp[net] = tw
+        cfs[c.id] = cf
     # a pushed body hits its stop at speed and bounces off it (the whole scene: a 0.12 kg OR
     # bar 2 % of stroke past its end, settling no earlier than its closed form): only a net
     # that a follower downstream lands on a stop of its own, held there by its spring, takes
-    # the lead's earlier settle
-    return {net: tw for net, tw in warp.items() if net in landed}
+    # the lead's earlier settle. Each head's run only where such a net is wanted.
+    runs: dict[str, np.ndarray | None] = {}
+    out: dict[str, np.ndarray] = {}
+    for net in sorted(landed & wanted):
+        h = head_of[net]
+        if h not in runs:
+            pu = push[h]
+            mass, springs, sliders = _train(design, lib, index, pu, switched, loads,
+                                           moves_with)
+            energy = _spring_energy(index, springs, poses, size, sl)
+            runs[h] = _coast(ts, cfs[h], energy, mass, mech.ctx.friction * sliders,
+                             mech.ctx.stroke)
+        if runs[h] is not None:
+            out[net] = runs[h]
+    return out
 
 
-def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
+def _moves_with(design: Design, lib: Library, parts: _Parts, cid: str, switched: set[str],
                 loads: dict[str, float], poses, size: int, sl: slice, ts: np.ndarray) -> str:
     """Whether a switching cell's output moves with its inputs all along the move, so a lead
     of its inputs is its own: ``"pushed"`` when its springs store energy as it switches (its
@@ -411,7 +442,7 @@ def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
     mech, nl = design.mechanism, design.netlist
     if cid not in mech.cells or lib[nl.cells[cid].cell].stateful:
         return ""
-    index = mech.body_index()
+    index = parts.index
     part = mech.cells[cid]
     term = part.terminals.get(lib[nl.cells[cid].cell].outputs[0])
     if term is None or term.body not in index:
@@ -420,19 +451,18 @@ def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
                          (size,))[sl]
     if abs(float(cf[-1] - cf[0])) < 0.5:
         return ""
-    energy = _spring_energy(mech, part.springs, poses, size, sl)
+    energy = _spring_energy(index, part.springs, poses, size, sl)
     if energy[-1] > energy[0]:
         return "pushed"  # by its inputs
     # moved by springs: its own and those of what it drives down the path (a load's spring
     # that presses on its input pushes this output along through the net)
-    index = mech.body_index()
-    ins = {r.load for p in mech.nets.values() for r in net_rods(p)}
-    own = [b for b in index if b.startswith(cid + ".") and b not in ins]
+    own = parts.own.get(cid, [])
     head = Pusher(cid, nl.cells[cid].outputs[0], term, term.body,
                   sum(index[b].mass for b in own), list(part.springs),
                   sum(index[b].kind == "slider" for b in own))
-    mass, springs, sliders = _train(design, lib, head, switched, loads, lambda _c: True)
-    energy = _spring_energy(mech, springs, poses, size, sl)
+    mass, springs, sliders = _train(design, lib, index, head, switched, loads,
+                                     lambda _c: True)
+    energy = _spring_energy(index, springs, poses, size, sl)
     y = (cf - cf[0]) / (cf[-1] - cf[0])
     step = np.diff(y)
     ok = step > 1e-9
@@ -443,20 +473,25 @@ def _moves_with(design: Design, lib: Library, cid: str, switched: set[str],
     # of the move, where the input starts to decelerate (a lead can only start there)
     ymid = 0.5 * (y[1:] + y[:-1])[ok]
     give = -np.diff(energy)[ok] / (step[ok] * S)  # N along the move
+    fric = mech.ctx.friction * sliders
+    speed = np.gradient(y, ts)
+    need = float(np.max(np.abs(np.gradient(speed, ts)))) * S / 1000.0  # m/s^2
+    if float(np.min(give)) - fric >= 1.25 * mass * need:
+        return "follows"  # it rides its inputs all along (no run needed)
     k = 1000.0 / (mass * S)
     n = int(ts[-1] / COAST_DT) + 2
     t = np.arange(n) * COAST_DT
     h = np.interp(t, ts, y)
-    x, v, gap = 0.0, 0.0, 0.0
+    x, v = 0.0, 0.0
     for i in range(1, n):
-        f = float(np.interp(x, ymid, give)) - (mech.ctx.friction * sliders if v > 0.0 else 0.0)
+        f = float(np.interp(x, ymid, give)) - (fric if v > 0.0 else 0.0)
         v += max(f, 0.0) * k * COAST_DT
         x += v * COAST_DT
         if x >= h[i]:  # its inputs hold it back: it rides them
             x, v = float(h[i]), (float(h[i]) - float(h[i - 1])) / COAST_DT
-        if t[i] >= 0.5 * ts[-1]:
-            gap = max(gap, float(h[i]) - x)
-    return "follows" if gap <= SETTLED else ""
+        if t[i] >= 0.5 * ts[-1] and float(h[i]) - x > SETTLED:
+            return ""
+    return "follows"
 
 
 def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
@@ -844,10 +879,10 @@ def pushers(design: Design, lib: Library) -> dict[str, Pusher]:
     return out
 
 
-def _spring_energy(mech, springs, poses, size: int, sl: slice) -> np.ndarray:
+def _spring_energy(index: dict, springs, poses, size: int, sl: slice) -> np.ndarray:
     """The energy (N mm) ``springs`` hold in each closed-form sample of ``sl`` (of ``size``
-    samples in ``poses``); tension springs, none below their rest length."""
-    index = mech.body_index()
+    samples in ``poses``; ``index``, the bodies by id); tension springs, none below their
+    rest length."""
     e = np.zeros(sl.stop - sl.start)
     for s in springs:
         ax, ay = position(index[s.a] if s.a != GROUND else None, poses, s.pa)
@@ -859,7 +894,7 @@ def _spring_energy(mech, springs, poses, size: int, sl: slice) -> np.ndarray:
     return e
 
 
-def _train(design: Design, lib: Library, head: Pusher, switched: set[str],
+def _train(design: Design, lib: Library, index: dict, head: Pusher, switched: set[str],
            loads: dict[str, float], moves_with) -> tuple[float, list, int]:
     """What a pushed output carries while it leads (see :class:`Pusher`): its mass (kg), the
     springs it works against or is helped by, and its sliders (each with the guides'
@@ -869,7 +904,6 @@ def _train(design: Design, lib: Library, head: Pusher, switched: set[str],
     gives nothing); only a moving load's output body and the nets' rods and load sliders
     count as mass."""
     mech, nl = design.mechanism, design.netlist
-    index = mech.body_index()
     mass, springs, sliders = head.mass, list(head.springs), head.sliders
     seen, todo = {head.cid}, [head.net]
     while todo:
@@ -909,6 +943,9 @@ def _coast(ts: np.ndarray, cf: np.ndarray, energy: np.ndarray, mass: float, fric
         return None
     ymid = 0.5 * (y[1:] + y[:-1])[ok]
     force = np.diff(energy)[ok] / (step[ok] * stroke)  # N opposing the move (the springs)
+    slow = -float(np.min(np.gradient(np.gradient(y, ts), ts))) * stroke / 1000.0  # m/s^2
+    if float(np.min(force)) + friction >= mass * slow:
+        return None  # the forces stop it as fast as its input slows: it never leaves it
     k = 1000.0 / (mass * stroke)  # N -> (fraction of the move)/s^2
     n = int(ts[-1] / COAST_DT) + 2
     t = np.arange(n) * COAST_DT
