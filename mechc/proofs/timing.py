@@ -50,7 +50,6 @@ from mechc.ir.mechanism import GROUND
 from mechc.ir.netlist import Netlist
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
-from mechc.parts.base import position
 from mechc.parts.pushrod import net_rods
 from mechc.physics.evaluate import evaluate, output_signals, signal_of
 from mechc.physics.scene import DynSettings, min_jerk
@@ -249,8 +248,6 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                    "as_built": tab.as_built} if tab is not None else None)
             for cid, tab in tables.items()}
     follow = followers(design, lib)
-    push = pushers(design, lib)
-    parts = _Parts.of(design) if push else None
     hold = st.move_time + st.settle_time
     out: list[dict] = []
     frac = np.linspace(0.0, 1.0, SAMPLES)
@@ -266,7 +263,7 @@ def predict_changes(design: Design, lib: Library, names: list[str],
             vals[nm] = np.concatenate(cols)
         poses = evaluate(mech, lib, types, vals)
         sig = output_signals(mech, poses)
-        bodies = mech.body_index()
+        bodies = mech.body_index() if follow else {}
         fsig = {}
         for cid in follow:
             term = mech.cells[cid].terminals[lib[types[cid]].outputs[0]]
@@ -292,10 +289,6 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 if got is not None:
                     here[c.id]["follower"] = got
             arrive, settle, path = _paths(nl, "in:" + moving, switched, here)
-            sl = slice(i * SAMPLES, (i + 1) * SAMPLES)
-            lead = (_leads(design, lib, parts, push, switched, arrive, here, loads, poses,
-                           len(chunk) * SAMPLES, sl, ts, set(nl.outputs.values()))
-                    if push else {})
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
             if detail:
@@ -321,14 +314,8 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 cid = driver[net].id if net in driver else None
                 lag = arrive.get(net, 0.0)
                 extra = settle.get(net, 0.0)
-                at_cross, at_settle = cf_cross, cf_settle
-                if net in lead:  # a pushed output upstream leads its input: so does this
-                    tw = lead[net]
-                    at_settle = settled_at(tw, s, end=float(s[-1]), within=SETTLED)
-                    c = crossing(tw, s)
-                    at_cross = c if math.isfinite(c) else cf_cross
-                rec["outputs"][o] = {"switch_s": round(at_cross + lag, 6),
-                                     "settle_s": round(at_settle + extra, 6),
+                rec["outputs"][o] = {"switch_s": round(cf_cross + lag, 6),
+                                     "settle_s": round(cf_settle + extra, 6),
                                      "closed_form_switch_s": round(cf_cross, 6),
                                      "closed_form_settle_s": round(cf_settle, 6),
                                      "path": path.get(net, [cid] if cid else [])}
@@ -337,161 +324,6 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 rec["nets_settle_s"] = max(rec["nets_settle_s"], rec["settle_s"])
             out.append(rec)
     return out
-
-
-@dataclass
-class _Parts:
-    """What the lead model reads of the mechanism on every change, gathered once: the bodies
-    by id and each cell's own bodies (not the input sliders its nets' rods drive)."""
-
-    index: dict
-    own: dict[str, list[str]]
-
-    @classmethod
-    def of(cls, design: Design) -> _Parts:
-        mech = design.mechanism
-        index = mech.body_index()
-        ins = {r.load for p in mech.nets.values() for r in net_rods(p)}
-        own = {cid: [b.id for b in part.bodies if b.id not in ins]
-               for cid, part in mech.cells.items()}
-        return cls(index, own)
-
-
-def _leads(design: Design, lib: Library, parts: _Parts, push: dict[str, Pusher],
-           switched: set[str],
-           arrive: dict[str, float], figs: dict[str, dict | None], loads: dict[str, float],
-           poses, size: int, sl: slice, ts: np.ndarray, wanted: set[str]
-           ) -> dict[str, np.ndarray]:
-    """Per switched net of ``wanted`` that a pushed output leads (:class:`Pusher`) and that
-    lands on a follower's stop: the times its closed form's samples are reached (earlier than
-    ``ts``).
-    The lead starts at a cell pushed against its springs whose inputs arrive when the closed
-    form says (no lag, nothing timed as built upstream) and passes to every cell that moves
-    with its inputs and all of whose switching inputs it leads (a cell with a switching input
-    that it does not lead is left alone)."""
-    mech, nl = design.mechanism, design.netlist
-    index = parts.index
-    head_of: dict[str, str] = {}
-    cfs: dict[str, np.ndarray] = {}
-    known: dict[str, str] = {}
-    landed: set[str] = set()  # nets a follower after the head lands on its own stop
-
-    def moves_with(cid: str) -> str:
-        if cid not in known:
-            known[cid] = _moves_with(design, lib, parts, cid, switched, loads, poses, size,
-                                     sl, ts)
-        return known[cid]
-
-    for c in nl.topo_cells():
-        net = c.outputs[0]
-        if net not in switched:
-            continue
-        ins = [x for x in c.inputs if x in arrive]
-        if not ins:
-            continue
-        heads = {head_of.get(x) for x in ins}
-        if len(heads) == 1 and None not in heads:
-            how = moves_with(c.id)
-            if how:
-                head_of[net] = heads.pop()
-                if how == "follows" or all(x in landed for x in ins):
-                    landed.add(net)
-            continue
-        pu = push.get(c.id)
-        f = figs.get(c.id) or {}
-        if (heads != {None} or pu is None or f.get("as_built")
-                or max(arrive[x] for x in ins) > 0.0):
-            continue
-        cf = signal_of(pu.term, index[pu.body], poses)
-        cf = np.broadcast_to(np.asarray(cf, dtype=float), (size,))[sl]
-        if abs(float(cf[-1] - cf[0])) < 0.5:
-            continue
-        own = _spring_energy(index, pu.springs, poses, size, sl)
-        if own[-1] <= own[0]:
-            continue  # its spring moves it this way: not pushed
-        head_of[net] = c.id
-        cfs[c.id] = cf
-    # a pushed body hits its stop at speed and bounces off it (the whole scene: a 0.12 kg OR
-    # bar 2 % of stroke past its end, settling no earlier than its closed form): only a net
-    # that a follower downstream lands on a stop of its own, held there by its spring, takes
-    # the lead's earlier settle. Each head's run only where such a net is wanted.
-    runs: dict[str, np.ndarray | None] = {}
-    out: dict[str, np.ndarray] = {}
-    for net in sorted(landed & wanted):
-        h = head_of[net]
-        if h not in runs:
-            pu = push[h]
-            mass, springs, sliders = _train(design, lib, index, pu, switched, loads,
-                                           moves_with)
-            energy = _spring_energy(index, springs, poses, size, sl)
-            runs[h] = _coast(ts, cfs[h], energy, mass, mech.ctx.friction * sliders,
-                             mech.ctx.stroke)
-        if runs[h] is not None:
-            out[net] = runs[h]
-    return out
-
-
-def _moves_with(design: Design, lib: Library, parts: _Parts, cid: str, switched: set[str],
-                loads: dict[str, float], poses, size: int, sl: slice, ts: np.ndarray) -> str:
-    """Whether a switching cell's output moves with its inputs all along the move, so a lead
-    of its inputs is its own: ``"pushed"`` when its springs store energy as it switches (its
-    inputs push it), ``"follows"`` when
-    they (with those of the loads it drives down the path) give it back fast enough to
-    accelerate the cell's bodies and what it drives as the closed form asks (it keeps up; one
-    that falls behind does not follow a lead either: ``""``)."""
-    mech, nl = design.mechanism, design.netlist
-    if cid not in mech.cells or lib[nl.cells[cid].cell].stateful:
-        return ""
-    index = parts.index
-    part = mech.cells[cid]
-    term = part.terminals.get(lib[nl.cells[cid].cell].outputs[0])
-    if term is None or term.body not in index:
-        return ""
-    cf = np.broadcast_to(np.asarray(signal_of(term, index[term.body], poses), dtype=float),
-                         (size,))[sl]
-    if abs(float(cf[-1] - cf[0])) < 0.5:
-        return ""
-    energy = _spring_energy(index, part.springs, poses, size, sl)
-    if energy[-1] > energy[0]:
-        return "pushed"  # by its inputs
-    # moved by springs: its own and those of what it drives down the path (a load's spring
-    # that presses on its input pushes this output along through the net)
-    own = parts.own.get(cid, [])
-    head = Pusher(cid, nl.cells[cid].outputs[0], term, term.body,
-                  sum(index[b].mass for b in own), list(part.springs),
-                  sum(index[b].kind == "slider" for b in own))
-    mass, springs, sliders = _train(design, lib, index, head, switched, loads,
-                                     lambda _c: True)
-    energy = _spring_energy(index, springs, poses, size, sl)
-    y = (cf - cf[0]) / (cf[-1] - cf[0])
-    step = np.diff(y)
-    ok = step > 1e-9
-    if not ok.any():
-        return ""
-    S = mech.ctx.stroke
-    # a one-dimensional run of it behind its inputs: it must be back on them by the middle
-    # of the move, where the input starts to decelerate (a lead can only start there)
-    ymid = 0.5 * (y[1:] + y[:-1])[ok]
-    give = -np.diff(energy)[ok] / (step[ok] * S)  # N along the move
-    fric = mech.ctx.friction * sliders
-    speed = np.gradient(y, ts)
-    need = float(np.max(np.abs(np.gradient(speed, ts)))) * S / 1000.0  # m/s^2
-    if float(np.min(give)) - fric >= 1.25 * mass * need:
-        return "follows"  # it rides its inputs all along (no run needed)
-    k = 1000.0 / (mass * S)
-    n = int(ts[-1] / COAST_DT) + 2
-    t = np.arange(n) * COAST_DT
-    h = np.interp(t, ts, y)
-    x, v = 0.0, 0.0
-    for i in range(1, n):
-        f = float(np.interp(x, ymid, give)) - (fric if v > 0.0 else 0.0)
-        v += max(f, 0.0) * k * COAST_DT
-        x += v * COAST_DT
-        if x >= h[i]:  # its inputs hold it back: it rides them
-            x, v = float(h[i]), (float(h[i]) - float(h[i - 1])) / COAST_DT
-        if t[i] >= 0.5 * ts[-1] and float(h[i]) - x > SETTLED:
-            return ""
-    return "follows"
 
 
 def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
@@ -824,152 +656,3 @@ def followers(design: Design, lib: Library) -> dict[str, Follower]:
         out[c.id] = Follower(c.id, net, index[body].mass + loads.get(net, 0.0), fr * sliders,
                              S, (dx / ln, dy / ln), term.off, term.design_point, springs)
     return out
-
-
-# ---- a pushed output: how far its momentum carries it ahead of a decelerating input -------
-#: Time step (s) of the one-dimensional coasting model.
-COAST_DT = 2.5e-4
-
-
-@dataclass
-class Pusher:
-    """A cell output body moved against its own spring by one-sided contacts with the cell's
-    inputs (an OR's bar going on). It cannot fall behind its inputs, but in the second half of
-    a minimum-jerk move its input decelerates; when the forces opposing it (the springs it
-    and what it drives store energy in, the guides' friction) cannot decelerate it and the
-    bodies it carries as fast, it leaves the input and coasts ahead until its stop takes it
-    or the input catches up. What it carries moves with it: its net's rods and loads'
-    sliders, and the output bodies of loads that switch with it, down the path (the
-    *train*). The model is a lower bound of the lead: the train's mass counts only those
-    bodies (a load's levers and a NOR's bar are left out) and every spring of the train's
-    cells counts with the force the closed form says it stores or gives back."""
-
-    cid: str
-    net: str
-    term: object  # the output terminal
-    body: str
-    mass: float  # kg: the output body
-    springs: list  # the part's springs that act on the output body (not on its inputs)
-    sliders: int  # the output body is a slider (1) or not (0)
-
-
-def pushers(design: Design, lib: Library) -> dict[str, Pusher]:
-    """Every cell whose output body has a spring to the ground and one-sided contacts with
-    the cell's inputs, the candidates of :class:`Pusher` (which way a change moves it decides
-    whether it is pushed)."""
-    mech, nl = design.mechanism, design.netlist
-    index = mech.body_index()
-    out: dict[str, Pusher] = {}
-    for c in nl.cells.values():
-        cls = lib[c.cell]
-        if cls.stateful or per_instance(cls) or c.id not in mech.cells:
-            continue
-        part = mech.cells[c.id]
-        term = part.terminals.get(cls.outputs[0])
-        if term is None or term.kind != "translating":
-            continue
-        body = term.body
-        springs = [s for s in part.springs if GROUND in (s.a, s.b) and body in (s.a, s.b)]
-        pressed = any(j.kind in ("contact", "touch") and body in (j.a, j.b)
-                      and GROUND not in (j.a, j.b) for j in part.joints)
-        if not springs or not pressed:
-            continue
-        out[c.id] = Pusher(c.id, c.outputs[0], term, body, index[body].mass, springs,
-                           1 if index[body].kind == "slider" else 0)
-    return out
-
-
-def _spring_energy(index: dict, springs, poses, size: int, sl: slice) -> np.ndarray:
-    """The energy (N mm) ``springs`` hold in each closed-form sample of ``sl`` (of ``size``
-    samples in ``poses``; ``index``, the bodies by id); tension springs, none below their
-    rest length."""
-    e = np.zeros(sl.stop - sl.start)
-    for s in springs:
-        ax, ay = position(index[s.a] if s.a != GROUND else None, poses, s.pa)
-        bx, by = position(index[s.b] if s.b != GROUND else None, poses, s.pb)
-        ax, ay, bx, by = (np.broadcast_to(np.asarray(v, dtype=float), (size,))[sl]
-                          for v in (ax, ay, bx, by))
-        stretch = np.maximum(np.hypot(ax - bx, ay - by) - s.rest, 0.0)
-        e += 0.5 * s.rate * stretch * stretch
-    return e
-
-
-def _train(design: Design, lib: Library, index: dict, head: Pusher, switched: set[str],
-           loads: dict[str, float], moves_with) -> tuple[float, list, int]:
-    """What a pushed output carries while it leads (see :class:`Pusher`): its mass (kg), the
-    springs it works against or is helped by, and its sliders (each with the guides'
-    friction). Every load cell of the head's net and, through loads that switch and move with
-    their inputs (``moves_with``), of theirs down the path: a load's springs count (the closed
-    form says which store energy) unless it switches and falls behind its input (then it
-    gives nothing); only a moving load's output body and the nets' rods and load sliders
-    count as mass."""
-    mech, nl = design.mechanism, design.netlist
-    mass, springs, sliders = head.mass, list(head.springs), head.sliders
-    seen, todo = {head.cid}, [head.net]
-    while todo:
-        net = todo.pop()
-        mass += loads.get(net, 0.0)
-        if net not in mech.nets:
-            continue
-        for r in net_rods(mech.nets[net]):
-            sliders += r.load in index and index[r.load].kind == "slider"
-            oid = r.load.split(".", 1)[0]
-            if oid in seen or oid not in mech.cells or oid not in nl.cells:
-                continue
-            seen.add(oid)
-            c = nl.cells[oid]
-            if c.outputs[0] not in switched:
-                springs.extend(mech.cells[oid].springs)
-            elif moves_with(oid):
-                springs.extend(mech.cells[oid].springs)
-                term = mech.cells[oid].terminals.get(lib[c.cell].outputs[0])
-                if term is not None and term.body in index:
-                    mass += index[term.body].mass
-                    sliders += index[term.body].kind == "slider"
-                todo.append(c.outputs[0])
-    return mass, springs, sliders
-
-
-def _coast(ts: np.ndarray, cf: np.ndarray, energy: np.ndarray, mass: float, friction: float,
-           stroke: float) -> np.ndarray | None:
-    """When a pushed output reaches each closed-form sample's position, coasting ahead of its
-    input where the forces opposing it cannot decelerate it as fast as the input (``cf``, the
-    closed form at ``ts``; ``energy``, what the train's springs hold there): the closed form's
-    times made earlier, or None when it never leaves its input."""
-    y = (cf - cf[0]) / (cf[-1] - cf[0])  # 0 -> 1 along the move
-    step = np.diff(y)
-    ok = step > 1e-9
-    if ok.sum() < 2:
-        return None
-    ymid = 0.5 * (y[1:] + y[:-1])[ok]
-    force = np.diff(energy)[ok] / (step[ok] * stroke)  # N opposing the move (the springs)
-    slow = -float(np.min(np.gradient(np.gradient(y, ts), ts))) * stroke / 1000.0  # m/s^2
-    if float(np.min(force)) + friction >= mass * slow:
-        return None  # the forces stop it as fast as its input slows: it never leaves it
-    k = 1000.0 / (mass * stroke)  # N -> (fraction of the move)/s^2
-    n = int(ts[-1] / COAST_DT) + 2
-    t = np.arange(n) * COAST_DT
-    h = np.interp(t, ts, y)
-    x, v = 0.0, 0.0
-    path = np.empty(n)
-    led = False
-    for i in range(n):
-        if i:
-            f = float(np.interp(x, ymid, force)) + (friction if v > 0.0 else 0.0)
-            v -= f * k * COAST_DT
-            x += v * COAST_DT
-            if x <= h[i]:  # the input pushes it: it rides the input
-                x, v = float(h[i]), (float(h[i]) - float(h[i - 1])) / COAST_DT
-            else:
-                led = True
-            if x >= 1.0:  # its stop
-                path[i:] = 1.0
-                break
-        path[i] = x
-    if not led:
-        return None
-    path = np.maximum.accumulate(path)
-    at = np.searchsorted(path, y - 1e-12, side="left")
-    return np.minimum(t[np.minimum(at, n - 1)], ts)
-
-
