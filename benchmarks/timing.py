@@ -58,8 +58,9 @@ def adder2_spec():
     return parse_bool(text, "<adder2>")
 
 
-def circuits(quick: bool) -> list[tuple[str, object, int | None]]:
-    """(name, design, changes measured: None for the proof's whole plan)."""
+def circuits(quick: bool, extra: list[str] = ()) -> list[tuple[str, object, int | None]]:
+    """(name, design, changes measured: None for the proof's whole plan). ``extra``: more
+    compiled random specs, ``SEED:CELLS`` each (8 changes with ``quick``, else 16)."""
     out = [("sorter", compile_spec(load_spec(EXAMPLES / "sorter.bool")), None),
            ("full_adder", compile_spec(load_spec(EXAMPLES / "full_adder.bool")), None)]
     for cells, cases in ((30, 12 if quick else None), (100, 6 if quick else 24)):
@@ -69,6 +70,10 @@ def circuits(quick: bool) -> list[tuple[str, object, int | None]]:
                                 options=CompileOptions(mech=MechOptions(actuator_force=1e4)))
         out.append((f"random{len(d.netlist.cells)}", d, cases))
     out.append(("adder2_cin", compile_spec(adder2_spec()), 6 if quick else 16))
+    for item in extra:
+        seed, cells = (int(v) for v in item.split(":"))
+        d = random_compiled(cells, seed=seed)
+        out.append((f"random{len(d.netlist.cells)}_seed{seed}", d, 8 if quick else 16))
     return out
 
 
@@ -99,12 +104,14 @@ def main() -> None:
     ap.add_argument("--out", default=str(ROOT / "docs" / "perf"))
     ap.add_argument("--only", action="append", default=[], metavar="NAME",
                     help="measure only this circuit (repeatable)")
+    ap.add_argument("--extra-random", action="append", default=[], metavar="SEED:CELLS",
+                    help="also a compiled random spec of about CELLS cells (repeatable)")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     summary = []
-    for name, design, cases in circuits(args.quick):
+    for name, design, cases in circuits(args.quick, args.extra_random):
         if args.only and name not in args.only:
             continue
         spec = design.spec
