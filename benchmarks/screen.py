@@ -92,6 +92,23 @@ def failed_changes(rec: list[dict], report, st) -> set[int]:
     return bad
 
 
+def settle_early(dec: list[dict], rec: list[dict], st) -> dict[str, float]:
+    """How much later than predicted the whole scene settled, as a share of its settle, at
+    worst over the changes without a heavy cell (those a screen may clear) and over the heavy
+    ones, every change of the plan that settled after the move (the basis of
+    ``mechc.proofs.screen.MODEL_ERROR``; negative: every prediction late)."""
+    worst = {False: -math.inf, True: -math.inf}
+    for d, r in zip(dec, rec):
+        s = r["settle_time_s"]
+        if math.isfinite(s) and s > 0:
+            m = s + st.move_time
+            worst[bool(d["heavy"])] = max(worst[bool(d["heavy"])],
+                                          (m - d["predicted_settle_s"]) / m)
+    return {"settle_early_worst": round(worst[False], 4) if worst[False] > -math.inf else "",
+            "settle_early_worst_heavy": (round(worst[True], 4) if worst[True] > -math.inf
+                                         else "")}
+
+
 def worst_witness_gaps(design, rec: list[dict], st, settings) -> dict[str, float]:
     """Over the changes the screen may clear (no reason to run but being a witness): how far
     each one's joint stretch, contact overrun and held-output excess over its closed form went
@@ -201,6 +218,7 @@ def main() -> None:
                "overrun_gap_of_limit": round((worst["max_penetration_mm"]
                                               - worst_ran["max_penetration_mm"])
                                              / st.penetration_limit, 4),
+               **settle_early(dec, rec, st),
                **worst_witness_gaps(design, rec, st, settings),
                "load_before": round(load0, 2), "load_after": round(os.getloadavg()[0], 2)}
         rows.append(row)
