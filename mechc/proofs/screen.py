@@ -7,8 +7,9 @@ first (:mod:`mechc.proofs.timing`, no scene); a change is *cleared* only when, f
 of failure the dynamic proof can report, the screen models it with a stated margin:
 
 - ``settle``: the latest predicted settle of any switching net, grown by ``SETTLE_MARGIN``
-  (twice the timing model's worst *early* prediction measured by ``benchmarks/timing.py``: a
-  late prediction is on the safe side), is within the move and the hold.
+  (twice the timing model's worst *early* prediction over every change of the benchmark
+  circuits' plans, ``benchmarks/screen.py``: a late prediction is on the safe side), is
+  within the move and the hold.
 - ``rest``: every output's closed-form end is within ``tolerance - REST_MARGIN`` of what the
   spec asks (a settled scene stands within ``SETTLED`` of its closed form: twice that).
 - ``glitch``: every output that must hold is held by the logic whatever order its cells
