@@ -14,16 +14,17 @@ average before and after each circuit is in the row: the seconds are only compar
 a row.
 
 Circuits: those of ``benchmarks/timing.py`` (the sorter, the full adder, random23, random81, the
-2-bit adder with carry-in) and ``--random`` held-out random specs (3-4 inputs, 1-2 outputs,
-seeds 9100..; compiled by mechc as ``mechc.bench.circuits.random_compiled`` compiles). For
-each: both proofs' seconds and verdicts, the ratio, how many changes the screen ran in pymunk,
-and, from the dynamic proof's own record of every change, whether any change the screen cleared
-failed there (the soundness check) and how the worst joint stretch and contact overrun over all
-changes compare with the worst over the changes the screen chose to run before any fallback:
-their ratio and their gap as a share of the limit (the basis of
-``mechc.proofs.screen.JOINT_HEADROOM`` and ``CONTACT_HEADROOM``). Writes ``screen.csv`` and
-``screen.png`` (seconds of both proofs per circuit) to ``--out`` (default docs/perf);
-``--chart-from CSV`` redraws the chart of an earlier run.
+2-bit adder with carry-in), ``--extra-random SEED:CELLS`` compiled random specs never used for a
+margin (``--extra-only``: those alone) and ``--random`` held-out random specs (3-4 inputs, 1-2
+outputs, seeds 9100..; compiled by mechc as ``mechc.bench.circuits.random_compiled`` compiles). For
+each: both proofs' seconds and verdicts, the ratio, how many changes the screen ran in pymunk, and,
+from the dynamic proof's own record of every change, whether any change the screen cleared failed
+there (the soundness check) and how the worst joint stretch and contact overrun over all changes
+compare with the worst over the changes the screen chose to run before any fallback: their ratio
+and their gap as a share of the limit (the basis of ``mechc.proofs.screen.JOINT_HEADROOM`` and
+``CONTACT_HEADROOM``). Writes ``screen.csv`` and ``screen.png`` (seconds of both proofs per
+circuit) to ``--out`` (default docs/perf); ``--chart-from CSV`` redraws the chart of an earlier
+run.
 """
 
 from __future__ import annotations
@@ -97,16 +98,19 @@ def settle_early(dec: list[dict], rec: list[dict], st) -> dict[str, float]:
     worst over the changes without a heavy cell (those a screen may clear) and over the heavy
     ones, every change of the plan that settled after the move (the basis of
     ``mechc.proofs.screen.MODEL_ERROR``; negative: every prediction late)."""
-    worst = {False: -math.inf, True: -math.inf}
+    worst = {"settle_early_worst": -math.inf, "settle_early_worst_heavy": -math.inf,
+             "settle_early_worst_cleared": -math.inf}
     for d, r in zip(dec, rec):
         s = r["settle_time_s"]
         if math.isfinite(s) and s > 0:
             m = s + st.move_time
-            worst[bool(d["heavy"])] = max(worst[bool(d["heavy"])],
-                                          (m - d["predicted_settle_s"]) / m)
-    return {"settle_early_worst": round(worst[False], 4) if worst[False] > -math.inf else "",
-            "settle_early_worst_heavy": (round(worst[True], 4) if worst[True] > -math.inf
-                                         else "")}
+            e = (m - d["predicted_settle_s"]) / m
+            keys = ["settle_early_worst_heavy" if d["heavy"] else "settle_early_worst"]
+            if d["route"] == "timing":
+                keys.append("settle_early_worst_cleared")
+            for k in keys:
+                worst[k] = max(worst[k], e)
+    return {k: round(v, 4) if v > -math.inf else "" for k, v in worst.items()}
 
 
 def worst_witness_gaps(design, rec: list[dict], st, settings) -> dict[str, float]:
@@ -144,6 +148,11 @@ def main() -> None:
     ap.add_argument("--only", action="append", default=[], metavar="NAME")
     ap.add_argument("--random", type=int, default=4, metavar="N",
                     help="held-out random specs (default %(default)s)")
+    ap.add_argument("--extra-random", action="append", default=[], metavar="SEED:CELLS",
+                    help="also a compiled random spec of about CELLS cells, never used to set "
+                         "a margin (repeatable)")
+    ap.add_argument("--extra-only", action="store_true",
+                    help="measure only the --extra-random circuits")
     ap.add_argument("--out", default=str(ROOT / "docs" / "perf"))
     ap.add_argument("--chart-from", metavar="CSV", help="only redraw the chart of this CSV")
     args = ap.parse_args()
@@ -154,7 +163,11 @@ def main() -> None:
             chart(list(csv.DictReader(f)), out / "screen.png")
         return
     rows = []
-    for name, design, _ in [*circuits(True), *heldout(args.random)]:
+    every = circuits(True, args.extra_random)
+    k = len(every) - len(args.extra_random)
+    base, extra = every[:k], every[k:]
+    todo = extra if args.extra_only else [*base, *heldout(args.random), *extra]
+    for name, design, _ in todo:
         if args.only and name not in args.only:
             continue
         spec = design.spec
