@@ -30,7 +30,6 @@ from mechc.proofs.screen import (
     MODEL_ERROR,
     SETTLE_MARGIN,
     SOLVER_FACTOR,
-    calibrate,
     calibration_failures,
     concerned,
     decide,
@@ -115,7 +114,8 @@ def test_calibration_flags_each_kind_of_disagreement():
     timed = [{"nets_settle_s": 0.1, "closed_form_swing": {"z": 0.0}}]
 
     def bad(**kw) -> list[str]:
-        return calibrate(dec, timed, [0], [_rec(**kw)], st, 0.025, 0.05, 20.0)
+        return [f["text"] for f in calibration_failures(dec, timed, [0], [_rec(**kw)], st,
+                                                         0.025, 0.05, 20.0)]
 
     assert bad() == []
     # a joint or contact leaving less than its headroom of the limit: just inside, outside

@@ -328,15 +328,6 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
     return pairs, timed, decisions
 
 
-def calibrate(decisions: list[dict], timed: list[dict], run: list[int], record: list[dict],
-              st: DynSettings, held_margin: float, tolerance: float, stroke: float
-              ) -> list[str]:
-    """What the changes run in pymunk say against the screen's model (empty: nothing), as
-    text; :func:`calibration_failures` says which change and check each one is."""
-    return [f["text"] for f in calibration_failures(decisions, timed, run, record, st,
-                                                    held_margin, tolerance, stroke)]
-
-
 def calibration_failures(decisions: list[dict], timed: list[dict], run: list[int],
                          record: list[dict], st: DynSettings, held_margin: float,
                          tolerance: float, stroke: float) -> list[dict]:

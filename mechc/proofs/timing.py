@@ -358,8 +358,8 @@ def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
     # all the way (no lag, nothing to simulate): the common case of a light output
     speed = np.gradient(cf, ts)
     need = float(np.max(np.abs(np.gradient(speed, ts)))) * fo.stroke / 1000.0  # m/s^2
-    can = min(abs(fo.force(x)[0]) - fo.force(x)[1] * float(np.max(np.abs(speed))) * fo.stroke
-              for x in (0.0, 0.5, 1.0)) - fo.friction
+    top = float(np.max(np.abs(speed))) * fo.stroke
+    can = min(abs(f) - damp * top for f, damp in map(fo.force, (0.0, 0.5, 1.0))) - fo.friction
     if can > 0.0 and can / fo.mass >= 1.25 * need:
         return 0.0, 0.0
     t, x = fo.run(ts, cf, until)
