@@ -2,7 +2,7 @@
 dynamic proof (``--level dynamic``), both run here on the same circuits, in one process, one
 after the other.
 
-    python benchmarks/screen.py [--only NAME ...] [--random N] [--out DIR]
+    python benchmarks/screen.py [--only NAME ...] [--random N] [--hold SECONDS] [--out DIR]
 
 What is timed: the whole dynamic proof on one process (the reference), the screened proof as
 ``mechc simulate`` runs it by default (``--jobs`` = every core this process may use,
@@ -22,9 +22,12 @@ from the dynamic proof's own record of every change, whether any change the scre
 there (the soundness check) and how the worst joint stretch and contact overrun over all changes
 compare with the worst over the changes the screen chose to run before any fallback: their ratio
 and their gap as a share of the limit (the basis of ``mechc.proofs.screen.JOINT_HEADROOM`` and
-``CONTACT_HEADROOM``). Writes ``screen.csv`` and ``screen.png`` (seconds of both proofs per
-circuit) to ``--out`` (default docs/perf); ``--chart-from CSV`` redraws the chart of an earlier
-run.
+``CONTACT_HEADROOM``), and how near the changes the screen cleared came to each limit of the
+dynamic proof in the whole scene (``cleared_*_share``, ``cleared_nearest``: a share of 1 would be
+a failing change cleared). ``--hold`` shortens the hold after each move, so that the settle
+limit falls among the changes: there the settle margin decides and is tested. Writes
+``screen.csv`` and ``screen.png`` (seconds of both proofs per circuit) to ``--out`` (default
+docs/perf); ``--chart-from CSV`` redraws the chart of an earlier run.
 """
 
 from __future__ import annotations
@@ -47,7 +50,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from timing import LIB, circuits  # noqa: E402
 
 from mechc.ir.spec import OutputSpec, Spec  # noqa: E402
-from mechc.logic.cubes import Cube  # noqa: E402
+from mechc.logic.cubes import DC, Cube  # noqa: E402
 from mechc.pipeline import compile_spec  # noqa: E402
 from mechc.proofs.dynamic import prove_dynamic  # noqa: E402
 from mechc.proofs.parallel import available_cores  # noqa: E402
@@ -113,6 +116,42 @@ def settle_early(dec: list[dict], rec: list[dict], st) -> dict[str, float]:
     return {k: round(v, 4) if v > -math.inf else "" for k, v in worst.items()}
 
 
+def cleared_nearest(dec: list[dict], rec: list[dict], spec, st, tolerance: float,
+                    stroke: float) -> dict[str, object]:
+    """How near the changes the screen cleared came to each limit of the dynamic proof, in
+    the whole scene, as a share of that limit (1 or more: a failing change was cleared): the
+    settle after the move of ``settle_time``, a held output's excursion and a rest error of
+    the tolerance, the joint stretch and contact overrun of their limits, the input's lag at
+    the end of the stall limit. What a wrong margin would cost: a share near 1 is a change
+    the screen nearly passed wrongly."""
+    n = len(spec.inputs)
+    share = {"settle": 0.0, "held": 0.0, "rest": 0.0, "stretch": 0.0, "overrun": 0.0,
+             "stall": 0.0}
+    which = {k: "" for k in share}
+    for i, (d, r) in enumerate(zip(dec, rec)):
+        if d["route"] != "timing":
+            continue
+        vec = sum(int(r["inputs"][nm]) << (n - 1 - k) for k, nm in enumerate(spec.inputs))
+        want = spec.values_at(np.array([[(vec >> (n - 1 - k)) & 1] for k in range(n)],
+                                       dtype=bool))
+        rest = max([abs(r["final"][o] - int(want[o][0])) for o in r["final"]
+                    if o in want and int(want[o][0]) != DC] or [0.0])
+        s = r["settle_time_s"]
+        got = {"settle": s / st.settle_time if math.isfinite(s) else math.inf,
+               "held": max(r["held_deviation"].values(), default=0.0) / tolerance,
+               "rest": rest / tolerance,
+               "stretch": r["max_violation_mm"] / st.violation_limit,
+               "overrun": r["max_penetration_mm"] / st.penetration_limit,
+               "stall": r["servo_lag_end_mm"] / (tolerance * stroke)}
+        for k, v in got.items():
+            if v > share[k]:
+                share[k], which[k] = v, f"{i} ({d['moving']} to {d['to']})"
+    top = max(share, key=share.get)
+    return {**{f"cleared_{k}_share": round(v, 4) for k, v in share.items()},
+            "cleared_nearest": f"{top} {share[top]:.3f} on change {which[top]}"
+            if share[top] > 0 else ""}
+
+
 def worst_witness_gaps(design, rec: list[dict], st, settings) -> dict[str, float]:
     """Over the changes the screen may clear (no reason to run but being a witness): how far
     each one's joint stretch, contact overrun and held-output excess over its closed form went
@@ -153,6 +192,10 @@ def main() -> None:
                          "a margin (repeatable)")
     ap.add_argument("--extra-only", action="store_true",
                     help="measure only the --extra-random circuits")
+    ap.add_argument("--hold", type=float, metavar="SECONDS",
+                    help="hold each change this long after its move (default: the proof's "
+                         "own); a short hold puts the settle limit among the changes, where "
+                         "the settle margin is tested")
     ap.add_argument("--out", default=str(ROOT / "docs" / "perf"))
     ap.add_argument("--chart-from", metavar="CSV", help="only redraw the chart of this CSV")
     args = ap.parse_args()
@@ -172,6 +215,8 @@ def main() -> None:
             continue
         spec = design.spec
         st = dyn_settings(design)
+        if args.hold is not None:
+            st.settle_time = args.hold
         settings = ProofSettings()
         cores = available_cores()
         load0 = os.getloadavg()[0]
@@ -181,11 +226,11 @@ def main() -> None:
         full = prove_dynamic(design, spec, LIB, st, record=rec)
         t_full = time.perf_counter() - t0
         t0 = time.perf_counter()
-        scr = prove_screened(design, spec, LIB, ProofSettings(jobs=cores))
+        scr = prove_screened(design, spec, LIB, ProofSettings(jobs=cores), st=st)
         t_scr = time.perf_counter() - t0
         if cores > 1:
             t0 = time.perf_counter()
-            scr1 = prove_screened(design, spec, LIB, settings)
+            scr1 = prove_screened(design, spec, LIB, settings, st=st)
             t_scr1 = time.perf_counter() - t0
         else:
             scr1, t_scr1 = scr, t_scr
@@ -232,6 +277,8 @@ def main() -> None:
                                               - worst_ran["max_penetration_mm"])
                                              / st.penetration_limit, 4),
                **settle_early(dec, rec, st),
+               **cleared_nearest(dec, rec, spec, st, settings.tolerance,
+                                 design.mechanism.ctx.stroke),
                **worst_witness_gaps(design, rec, st, settings),
                "load_before": round(load0, 2), "load_after": round(os.getloadavg()[0], 2)}
         rows.append(row)
