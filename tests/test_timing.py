@@ -199,6 +199,30 @@ def test_cli_timing_level(cli):
     assert code == 2 and "timing level has none" in err
 
 
+def test_cli_timing_level_shows_the_critical_path_and_each_requirement(cli, tmp_path):
+    """What the terminal says is what the report holds: the critical path's output, cells and
+    settle; each ordering requirement with its slack and what decided it."""
+    rep = tmp_path / "r.json"
+    code, out, _ = cli("simulate", str(EXAMPLES / "full_adder.bool"), "--level", "timing",
+                       "--report", str(rep))
+    crit = json.loads(rep.read_text())["critical_path"]
+    line = next(x for x in out.splitlines() if x.startswith("critical path:"))
+    assert f"{crit['output']} settles {crit['settle_s']:.4f} s" in line
+    assert ", ".join(crit["path"]) in line
+    code, out, _ = cli("simulate", str(EXAMPLES / "speedctl.fsm"), "--level", "timing",
+                       "--report", str(rep))
+    reqs = json.loads(rep.read_text())["requirements"]
+    assert code == 0 and reqs
+    assert f"ordering requirements as timing inequalities ({len(reqs)}):" in out
+    for q in reqs:
+        shown = next(x for x in out.splitlines()
+                     if x.strip().startswith(f"{q['kind']} ({q['input']} ->"))
+        assert f"slack {q['slack_s']:+.4f} s" in shown
+        assert shown.endswith(": met") == q["met"]
+        assert ("met by compile's dynamic walk" in shown) == q["met_by_dynamic_walk"]
+    assert "ordering requirements  " in out  # the count's row is named for what it counts
+
+
 @pytest.mark.slow
 def test_amplifier_is_timed_as_built_and_predicts_its_landing(tmp_path, monkeypatch):
     """An AMPLIFIER's switching delay and landing depend on what compile sized it for: it is

@@ -30,6 +30,7 @@ SUMMARY_KEYS = [
     ("max_settle_time_s", "max time outputs moved on after an input stopped (s)"),
     ("min_transmission_angle_deg", "min transmission angle (deg)"),
     ("min_toggle_distance_deg", "min distance from toggle (deg)"),
+    ("min_slack_s", "min slack (s)"),
     ("seconds", "seconds"),
 ]
 
@@ -103,6 +104,8 @@ class ProofReport(Mapping):
         orderings a sequential circuit must respect."""
         r = self.to_json()
         rows = [[label, r[k]] for k, label in SUMMARY_KEYS if r.get(k) is not None]
+        if self.level == "timing" and self.kind == "sequential":  # its cases are these
+            rows[0][0] = "ordering requirements"
         lines = [table(rows, ["level " + self.level, "value"])]
         if self.accuracy:
             lines.append(accuracy_text(self.accuracy))
@@ -117,12 +120,38 @@ class ProofReport(Mapping):
         lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
         if self.failure_count > SHOWN_FAILURES:
             lines.append(f"  ... and {self.failure_count - SHOWN_FAILURES} more (see --report)")
+        lines += timing_text(r)
         hazards = (r.get("sequential") or {}).get("hazards") or []
         if hazards:  # timing the logic cannot remove: what the mechanism must respect
             lines.append(f"ordering requirements ({len(hazards)}; the kinematic and dynamic "
                          "levels check them):")
             lines += [f"  {h['kind']}: {h['requires']}" for h in hazards[:10]]
         return "\n".join(lines)
+
+
+def timing_text(r: dict) -> list[str]:
+    """The timing level's findings a reader looks for first: the critical path (the latest
+    settle of any output over every change, and the cells it goes through) and each ordering
+    requirement of a sequential design with its slack and what decided it."""
+    out = []
+    crit = r.get("critical_path")
+    if crit:
+        start = " ".join(f"{k}={v}" for k, v in crit["inputs"].items())
+        out.append(f"critical path: {crit['output']} settles {crit['settle_s']:.4f} s after "
+                   f"{crit['moving']} starts to go to {crit['to']} (to {start}), through "
+                   f"{', '.join(crit['path']) or 'no cell'}; budget {r['budget_s']:.3f} s "
+                   "(move and hold)")
+    reqs = r.get("requirements") or []
+    if reqs:
+        out.append(f"ordering requirements as timing inequalities ({len(reqs)}):")
+        for q in reqs[:SHOWN_FAILURES]:
+            verdict = ("met" if q["met"] else "not met by the inequality, met by compile's "
+                       "dynamic walk" if q["met_by_dynamic_walk"] else "NOT MET")
+            out.append(f"  {q['kind']} ({q['input']} -> {', '.join(q['memories'])}): "
+                       f"{q['text']}: {verdict}")
+        if len(reqs) > SHOWN_FAILURES:
+            out.append(f"  ... and {len(reqs) - SHOWN_FAILURES} more (see --report)")
+    return out
 
 
 def sampled_text(cases: int, coverage: dict) -> str:
