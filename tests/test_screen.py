@@ -188,10 +188,15 @@ def test_a_failed_calibration_runs_only_the_changes_it_concerns(monkeypatch):
         return got + [fake] if len(seen) == 1 else got
 
     monkeypatch.setattr(screen, "calibration_failures", one_failure)
-    rep = prove_screened(d, d.spec, LIB, ProofSettings())
+    ticks: list[tuple[int, int]] = []
+    rep = prove_screened(d, d.spec, LIB, ProofSettings(), lambda a, b: ticks.append((a, b)))
     sc = rep.figures["screen"]
     ran = {i for i, x in enumerate(sc["decisions"]) if x["route"] == "dynamic"}
     assert ran == set(first) | want
+    # the progress goes on counting through the fallback: it never goes back, and it ends
+    # at every change that ran
+    assert [a for a, _ in ticks] == sorted(a for a, _ in ticks)
+    assert ticks[-1] == (len(ran), len(ran))
     assert seen[1] == sorted(want)  # the changes that fell back were checked in turn
     assert sc["fell_back"] == len(want) and sc["dynamic"] == len(ran)
     assert rep.cases == 31 and rep.passed

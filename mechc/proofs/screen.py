@@ -169,9 +169,14 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     held_margin = HELD_MARGIN_SHARE * settings.tolerance
     run = [i for i, d in enumerate(decisions) if d["route"] == "dynamic"]
     record: list[dict] = []
+    done_before = [0]  # changes run by earlier rounds: a fallback's count goes on from them
+
+    def tick(done: int, total: int) -> None:
+        if progress is not None:
+            progress(done_before[0] + done, done_before[0] + total)
     kw = {"tolerance": settings.tolerance, "extra": settings.cases, "seed": settings.seed,
           "jobs": settings.jobs, "scheduler": settings.scheduler}
-    rep = prove_dynamic(design, spec, lib, st, progress=progress, only=run, record=record, **kw)
+    rep = prove_dynamic(design, spec, lib, st, progress=tick, only=run, record=record, **kw)
     for i, r in zip(run, record):
         decisions[i]["measured_settle_s"] = (round(r["settle_time_s"] + st.move_time, 5)
                                              if math.isfinite(r["settle_time_s"]) else None)
@@ -198,7 +203,8 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
             break
         more_rec: list[dict] = []
         again = sorted(rest)
-        more = prove_dynamic(design, spec, lib, st, progress=progress, only=again,
+        done_before[0] = len(run)
+        more = prove_dynamic(design, spec, lib, st, progress=tick, only=again,
                              record=more_rec, **kw)
         for i, r in zip(again, more_rec):
             decisions[i]["measured_settle_s"] = (round(r["settle_time_s"] + st.move_time, 5)
