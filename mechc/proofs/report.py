@@ -114,6 +114,8 @@ class ProofReport(Mapping):
         extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
         # a sampled proof says so where the verdict is read, not only in --report
         cases = sampled_text(self.cases, self.coverage)
+        if self.level == "timing" and self.kind == "sequential":
+            cases = f"{self.cases} ordering requirement{'' if self.cases == 1 else 's'}"
         lines.append(f"{verdict}: level {self.level}, {cases}, "
                      f"{self.failure_count} failures{extra}, {self.seconds:.3f} s"
                      + self.nothing_moved())
