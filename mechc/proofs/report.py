@@ -122,6 +122,7 @@ class ProofReport(Mapping):
         lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
         if self.failure_count > SHOWN_FAILURES:
             lines.append(f"  ... and {self.failure_count - SHOWN_FAILURES} more (see --report)")
+        lines += solver_hint(r)
         lines += timing_text(r)
         hazards = (r.get("sequential") or {}).get("hazards") or []
         if hazards:  # timing the logic cannot remove: what the mechanism must respect
@@ -129,6 +130,23 @@ class ProofReport(Mapping):
                          "levels check them):")
             lines += [f"  {h['kind']}: {h['requires']}" for h in hazards[:10]]
         return "\n".join(lines)
+
+
+def solver_hint(r: dict) -> list[str]:
+    """A joint stretch, a contact overrun or a late settle may be the solver's (too few
+    iterations, too coarse a step) rather than the mechanism's; the run that tells them apart
+    is the same proof at finer settings, so the terminal names it (docs/performance.md,
+    "Where the methods break")."""
+    kinds = r.get("failure_kinds") or {}
+    st = r.get("settings") or {}
+    if not {"solver", "contact", "settle"} & set(kinds) or not st or r.get("accuracy"):
+        return []
+    it, dt = st.get("iterations"), st.get("dt_s")
+    if it is None or dt is None:
+        return []
+    return ["joint stretch, contact overrun and late settling can be the solver's, not the "
+            f"mechanism's: run again with --iterations {2 * it} or --dt {dt / 2:g}; a failure "
+            "that goes away there was the solver's"]
 
 
 def timing_text(r: dict) -> list[str]:
