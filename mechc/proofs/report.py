@@ -104,7 +104,9 @@ class ProofReport(Mapping):
         orderings a sequential circuit must respect."""
         r = self.to_json()
         rows = [[label, r[k]] for k, label in SUMMARY_KEYS if r.get(k) is not None]
-        if self.level == "timing" and self.kind == "sequential":  # its cases are these
+        # a sequential timing proof's cases are its ordering requirements: named so
+        requirements = self.level == "timing" and self.kind == "sequential"
+        if requirements:
             rows[0][0] = "ordering requirements"
         lines = [table(rows, ["level " + self.level, "value"])]
         if self.accuracy:
@@ -114,7 +116,7 @@ class ProofReport(Mapping):
         extra = f" ({', '.join(f'{v} {k}' for k, v in kinds.items())})" if kinds else ""
         # a sampled proof says so where the verdict is read, not only in --report
         cases = sampled_text(self.cases, self.coverage)
-        if self.level == "timing" and self.kind == "sequential":
+        if requirements:
             cases = f"{self.cases} ordering requirement{'' if self.cases == 1 else 's'}"
         lines.append(f"{verdict}: level {self.level}, {cases}, "
                      f"{self.failure_count} failures{extra}, {self.seconds:.3f} s"
