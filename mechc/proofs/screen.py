@@ -171,11 +171,12 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     held_margin = HELD_MARGIN_SHARE * settings.tolerance
     run = [i for i, d in enumerate(decisions) if d["route"] == "dynamic"]
     record: list[dict] = []
-    done_before = [0]  # changes run by earlier rounds: a fallback's count goes on from them
+    done_before = 0  # changes run by earlier rounds: a fallback's count goes on from them
 
     def tick(done: int, total: int) -> None:
         if progress is not None:
-            progress(done_before[0] + done, done_before[0] + total)
+            progress(done_before + done, done_before + total)
+
     kw = {"tolerance": settings.tolerance, "extra": settings.cases, "seed": settings.seed,
           "jobs": settings.jobs, "scheduler": settings.scheduler}
     rep = prove_dynamic(design, spec, lib, st, progress=tick, only=run, record=record, **kw)
@@ -205,7 +206,7 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
             break
         more_rec: list[dict] = []
         again = sorted(rest)
-        done_before[0] = len(run)
+        done_before = len(run)
         more = prove_dynamic(design, spec, lib, st, progress=tick, only=again,
                              record=more_rec, **kw)
         for i, r in zip(again, more_rec):
