@@ -250,7 +250,7 @@ def predict_changes(design: Design, lib: Library, names: list[str],
             for cid, tab in tables.items()}
     follow = followers(design, lib)
     out_cells = [c.id for c in nl.cells.values() if c.id in mech.cells
-                 and lib[types[c.id]].outputs[0] in mech.cells[c.id].terminals]
+                 and lib[types[c.id]].outputs[0] in mech.cells[c.id].terminals] if detail else []
     hold = st.move_time + st.settle_time
     out: list[dict] = []
     frac = np.linspace(0.0, 1.0, SAMPLES)
