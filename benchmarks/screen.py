@@ -54,7 +54,7 @@ from mechc.logic.cubes import DC, Cube  # noqa: E402
 from mechc.pipeline import compile_spec  # noqa: E402
 from mechc.proofs.dynamic import prove_dynamic  # noqa: E402
 from mechc.proofs.parallel import available_cores  # noqa: E402
-from mechc.proofs.screen import _kind, decide, prove_screened  # noqa: E402
+from mechc.proofs.screen import _columns, _kind, decide, prove_screened  # noqa: E402
 from mechc.proofs.settings import ProofSettings, dyn_settings  # noqa: E402
 from mechc.proofs.timing import cell_tables  # noqa: E402
 
@@ -128,14 +128,14 @@ def cleared_nearest(dec: list[dict], rec: list[dict], spec, st, tolerance: float
     share = {"settle": 0.0, "held": 0.0, "rest": 0.0, "stretch": 0.0, "overrun": 0.0,
              "stall": 0.0}
     which = {k: "" for k in share}
+    # what the spec asks after every change, in one evaluation
+    want = spec.values_at(_columns([sum(int(r["inputs"][nm]) << (n - 1 - k)
+                                        for k, nm in enumerate(spec.inputs)) for r in rec], n))
     for i, (d, r) in enumerate(zip(dec, rec)):
         if d["route"] != "timing":
             continue
-        vec = sum(int(r["inputs"][nm]) << (n - 1 - k) for k, nm in enumerate(spec.inputs))
-        want = spec.values_at(np.array([[(vec >> (n - 1 - k)) & 1] for k in range(n)],
-                                       dtype=bool))
-        rest = max([abs(r["final"][o] - int(want[o][0])) for o in r["final"]
-                    if o in want and int(want[o][0]) != DC] or [0.0])
+        rest = max([abs(r["final"][o] - int(want[o][i])) for o in r["final"]
+                    if o in want and int(want[o][i]) != DC] or [0.0])
         s = r["settle_time_s"]
         got = {"settle": s / st.settle_time if math.isfinite(s) else math.inf,
                "held": max(r["held_deviation"].values(), default=0.0) / tolerance,
