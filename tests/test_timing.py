@@ -290,3 +290,30 @@ def test_an_internal_net_settles_from_its_own_closed_form():
             names[k], float((vec >> (n - 1 - k)) & 1))
         measured = r.settle_time + st.move_time
         assert 0.85 * measured <= p["nets_settle_s"] <= 1.15 * measured
+
+
+NO_ORDERING = """inputs x1 x2
+outputs Z
+columns 00 01 11 10
+flow
+1: (1) (1) - 2 | 0
+2: 1 - 3 (2) | 0
+3: - - (3) 4 | 1
+4: 1 - 3 (4) | 1
+initial 1
+"""
+
+
+def test_sequential_timing_with_no_requirement_does_not_claim_power_up_only(cli, tmp_path):
+    """A flow table whose changes raise no ordering requirement has input changes all the same:
+    the verdict says what the zero counts, not that only the power-up state was checked."""
+    path = tmp_path / "latch.fsm"
+    path.write_text(NO_ORDERING)
+    rep = tmp_path / "r.json"
+    code, out, err = cli("simulate", str(path), "--level", "timing", "--report", str(rep))
+    assert code == 0, err
+    assert json.loads(rep.read_text())["requirements"] == []
+    verdict = next(x for x in out.splitlines() if x.startswith("PASSED: level timing"))
+    assert "0 ordering requirements" in verdict
+    assert "power-up" not in verdict
+    assert "no ordering requirement to time" in verdict

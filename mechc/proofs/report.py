@@ -61,6 +61,10 @@ class ProofReport(Mapping):
     def nothing_moved(self) -> str:
         """A sequential proof that took no input change proves power-up only, and says so
         where the verdict is read."""
+        if self.kind == "sequential" and self.level == "timing":
+            # its cases are ordering requirements, not input changes
+            return (" (the flow table's analysis found no ordering requirement to time)"
+                    if self.cases == 0 else "")
         if self.kind == "sequential" and (self.cases == 0 or
                                           self.coverage.get("transitions") == 0):
             return " (no input change to check: power-up state only)"
