@@ -290,7 +290,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                                      [len(seg) for seg in segments])
             for run in seg]
     failures: list[dict] = []
-    counts = {"rest": 0, "glitch": 0, "settle": 0, "stall": 0, "solver": 0, "contact": 0}
+    counts = dict.fromkeys(CHANGE_KINDS, 0)
     max_err = max_vio = max_pen = max_settle = 0.0
     worst_joint = ""
     max_dev = 0.0
