@@ -13,7 +13,9 @@ Each change starts on a scene built at rest in its start state (a combinational 
 is a function of its inputs), so the changes are independent cases: ``jobs`` processes or a Dask
 cluster run them (``mechc.proofs.parallel``) and the report is the serial run's, case by case.
 With ``prune`` each change runs on a scene of only the cells that can move the outputs
-(``mechc.proofs.prune``); off by default, see docs/performance.md for why.
+(``mechc.proofs.prune``); off by default, see docs/performance.md for why. The first
+``RECHECK_MAX`` changes failing on solver, contact or settle run again at twice the iterations
+(:func:`recheck_failures`): the report says which failures were the solver's.
 """
 
 from __future__ import annotations
