@@ -143,18 +143,22 @@ def test_simulate_passes_on_own_spec_and_on_spec_file(cli, tmp_path):
 
 
 def test_a_solver_failure_names_the_run_that_tells_it_from_the_mechanism(cli, tmp_path):
-    """One solver iteration per step breaks the full adder's joints: the terminal says how to
-    tell the solver from the mechanism (twice the iterations, half the step, from the
-    settings the report used); a passing proof says nothing of it."""
+    """One solver iteration per step breaks the full adder's joints: the proof runs the first
+    failing changes again at twice the iterations and says how many passed there; the changes
+    beyond that cap keep the hint (twice the iterations, half the step, from the settings the
+    report used); a passing proof says nothing of it."""
     report = tmp_path / "r.json"
     code, out, _ = cli("simulate", EXAMPLES / "full_adder.bool", "--level", "dynamic",
                        "--iterations", "1", "--report", report)
     r = json.loads(report.read_text())
     assert code == 1 and {"solver", "settle"} & set(r["failure_kinds"])
+    rc = r["recheck"]
+    assert f"re-run at 2 iterations: {rc['passed_finer']} of {rc['changes']} failing" in out
     hint = next(x for x in out.splitlines() if "can be the solver's" in x)
+    assert "were not re-run" in hint
     assert "--iterations 2 " in hint and f"--dt {r['settings']['dt_s'] / 2:g};" in hint
     code, out, _ = cli("simulate", EXAMPLES / "full_adder.bool", "--level", "dynamic")
-    assert code == 0 and "can be the solver's" not in out
+    assert code == 0 and "can be the solver's" not in out and "re-run at" not in out
 
 
 def test_simulate_rejects_mismatched_interface(cli, tmp_path):

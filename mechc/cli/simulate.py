@@ -16,6 +16,7 @@ from mechc.ir.spec import Spec
 from mechc.physics.scene import DynSettings
 from mechc.proofs import LEVELS, ProofReport, ProofSettings, prove, spec_kind
 from mechc.proofs import trace as pose_trace
+from mechc.proofs.dynamic import RECHECK_MAX
 from mechc.proofs.parallel import available_cores
 from mechc.proofs.settings import LOGIC_METHODS
 from mechc.ui import Progress, finite_float
@@ -68,6 +69,12 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
                    help="dynamic: solver iterations per step (default 60)")
     s.add_argument("--move-time", type=finite_float, default=None, metavar="S",
                    help="dynamic: seconds an input takes to move (default 0.08)")
+    s.add_argument("--no-recheck", dest="recheck", action="store_false",
+                   help="dynamic and screened: do not run the changes failing on a joint "
+                   "stretch, contact overrun or late settle again at twice the iterations "
+                   f"(by default the first {RECHECK_MAX} are, to tell the solver's failures "
+                   "from the mechanism's; each costs about twice a change at the proof's "
+                   "settings)")
     s.add_argument("--prune", action="store_true",
                    help="dynamic: run each input change on a scene of only the cells it can "
                    "move (see docs/performance.md)")
@@ -182,7 +189,7 @@ def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: 
                              logic_method=args.logic_method,
                              prune=args.prune, accuracy=args.accuracy, dt=args.dt,
                              iterations=args.iterations, move_time=args.move_time,
-                             trace=trace, jobs=args.jobs or available_cores(),
+                             recheck=args.recheck, trace=trace, jobs=args.jobs or available_cores(),
                              scheduler=args.scheduler)
     if args.level == "logic":
         return prove(design, spec, lib, args.level, settings)

@@ -13,7 +13,9 @@ Each change starts on a scene built at rest in its start state (a combinational 
 is a function of its inputs), so the changes are independent cases: ``jobs`` processes or a Dask
 cluster run them (``mechc.proofs.parallel``) and the report is the serial run's, case by case.
 With ``prune`` each change runs on a scene of only the cells that can move the outputs
-(``mechc.proofs.prune``); off by default, see docs/performance.md for why.
+(``mechc.proofs.prune``); off by default, see docs/performance.md for why. The first
+``RECHECK_MAX`` changes failing on solver, contact or settle run again at twice the iterations
+(:func:`recheck_failures`): the report says which failures were the solver's.
 """
 
 from __future__ import annotations
@@ -44,6 +46,14 @@ from mechc.proofs.trace import TraceRecorder
 
 MAX_LISTED = 50
 PRUNE_DEFAULT = False  # per-change pruned scenes (mechc.proofs.prune); see docs/performance.md
+#: Failure kinds that can be the solver's rather than the mechanism's: a change failing on one
+#: of them is run again at twice the solver iterations (:func:`recheck_failures`).
+RECHECKED = frozenset({"solver", "contact", "settle"})
+#: The failure kinds of one change (a design check belongs to the mechanism, not a change).
+CHANGE_KINDS = ("rest", "glitch", "settle", "stall", "solver", "contact")
+#: At most this many failing changes are run again (the first in plan order): each costs about
+#: twice a change at the proof's own settings.
+RECHECK_MAX = 6
 
 
 def plan(n: int, extra: int, seed: int) -> list[int]:
@@ -89,7 +99,8 @@ def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSett
     return prove_dynamic(design, spec, lib, st, tolerance=settings.tolerance,
                          extra=settings.cases, seed=settings.seed, progress=progress,
                          prune=settings.prune or PRUNE_DEFAULT, trace=settings.trace,
-                         jobs=settings.jobs, scheduler=settings.scheduler)
+                         jobs=settings.jobs, scheduler=settings.scheduler,
+                         recheck=settings.recheck)
 
 
 @dataclass
@@ -170,6 +181,57 @@ def _lean(r: MoveResult) -> MoveResult:
     return r
 
 
+@dataclass
+class ChangeCheck:
+    """What one change's checks found: its failures (``kind`` and what was measured, without
+    the change's inputs) and the figures the report keeps the worst of."""
+
+    failures: list[dict]
+    error: float  # the largest distance of an output at rest from its closed-form rest
+    deviation: float  # the largest distance of an output from the spec (at rest or held)
+
+
+def check_change(r: MoveResult, ch: Change, moving: str, st: DynSettings, tolerance: float,
+                 stroke: float) -> ChangeCheck:
+    """Every check of one change, the one code path for the proof's run and for the finer
+    re-run of its failures (:func:`recheck_failures`)."""
+    out: list[dict] = []
+    err = dev_max = 0.0
+    if r.max_violation > st.violation_limit or not math.isfinite(r.max_violation):
+        out.append({"kind": "solver", "message": f"solver error: joint {r.worst_joint} "
+                    f"stretched {r.max_violation:.4g} mm (limit {st.violation_limit} mm)"})
+    if r.max_penetration > st.penetration_limit:
+        out.append({"kind": "contact", "message": f"solver error: a contact overrun by "
+                    f"{r.max_penetration:.4g} mm (limit {st.penetration_limit} mm)"})
+    if not math.isfinite(r.settle_time):
+        out.append({"kind": "settle", "message": f"not settled {st.settle_time} s after the "
+                    "move"})
+    lag = r.servo_lag_end if hasattr(r, "servo_lag_end") else None
+    if lag is not None and lag > tolerance * stroke:
+        out.append({"kind": "stall", "message": f"input {moving} ended {lag:.3g} mm short of "
+                    "its target"})
+    for o, want in ch.after.items():
+        was = ch.before[o]
+        got = r.final.get(o)
+        if got is None:
+            continue
+        ref_end = float(r.reference[o][-1]) if o in r.reference else got
+        err = max(err, abs(got - ref_end))
+        if want != DC:
+            dev = abs(got - want)
+            dev_max = max(dev_max, dev)
+            if dev > tolerance or not math.isfinite(dev):
+                out.append({"kind": "rest", "output": o, "expected": want,
+                            "position": round(got, 6)})
+        if want != DC and want == was and o in r.outputs:
+            glitch = float(np.max(np.abs(r.outputs[o] - want)))
+            dev_max = max(dev_max, glitch)
+            if glitch > tolerance:
+                out.append({"kind": "glitch", "output": o, "expected": want,
+                            "max_deviation": round(glitch, 6)})
+    return ChangeCheck(out, err, dev_max)
+
+
 def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSettings | None = None,
                   tolerance: float = 0.05, extra: int = 16, seed: int = 0,
                   progress: Callable[[int, int], None] | None = None,
@@ -177,7 +239,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                   max_cases: int | None = None, record: list | None = None,
                   freeze: str | None = None, trace: TraceRecorder | None = None,
                   jobs: int = 1, scheduler: str | None = None,
-                  only: list[int] | None = None) -> ProofReport:
+                  only: list[int] | None = None, recheck: bool = True) -> ProofReport:
     """Every change is a case of its own: it runs on a scene built at rest (the closed form)
     in its start state, so cases can run on ``jobs`` processes or on the Dask cluster at
     ``scheduler`` (:mod:`mechc.proofs.parallel`) and the report is the serial one, case by
@@ -188,7 +250,10 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     (the screened proof, ``mechc.proofs.screen``); ``record`` (a list) receives each change's
     inputs, final output positions and measures (for step-halving checks and the screen);
     ``freeze``: which still bodies a pruned
-    scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``)."""
+    scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``).
+    ``recheck``: the changes failing on a kind the solver may cause run again at twice the
+    iterations (:func:`recheck_failures`; not on one scene nor with a trace); it adds to the
+    report, it never changes the verdict."""
     t0 = time.perf_counter()
     st = settings or dyn_settings(design)
     if design.mechanism is None:
@@ -218,16 +283,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         pairs = [pairs[i] for i in only]
     vectors = [vec for _, vec in pairs]
 
-    def columns(vs: list[int]) -> np.ndarray:
-        return np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in vs],
-                        dtype=bool).reshape(len(vs), n).T
-
-    before = spec.values_at(columns([cur for cur, _ in pairs]))
-    after = spec.values_at(columns(vectors))
     job = ChangeJob(design, names, types, st, cells, prune, freeze, trace)
-    changes = [Change(cur, vec, {o: int(before[o][i]) for o in spec.outputs},
-                      {o: int(after[o][i]) for o in spec.outputs})
-               for i, (cur, vec) in enumerate(pairs)]
+    changes = _changes(spec, names, pairs)
     segments = [changes] if one_scene else [[c] for c in changes]
     if trace is not None:  # the recorder lives in this process: the changes run here
         jobs, scheduler = 1, None
@@ -235,22 +292,22 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                                      [len(seg) for seg in segments])
             for run in seg]
     failures: list[dict] = []
-    counts = {"rest": 0, "glitch": 0, "settle": 0, "stall": 0, "solver": 0, "contact": 0}
+    counts = dict.fromkeys(CHANGE_KINDS, 0)
     max_err = max_vio = max_pen = max_settle = 0.0
     worst_joint = ""
     max_dev = 0.0
     steps = 0
-    for i, ((cur, vec), run) in enumerate(zip(pairs, runs)):
+    failing: list[tuple[int, int]] = []  # changes a finer solver setting may pass
+    for ch, run in zip(changes, runs):
         r = run.result
         if prune:
             sizes.append(run.size)
             escalated += run.escalated
             max_watch = max(max_watch, run.watch_deviation)
-        k = (n - 1) - (cur ^ vec).bit_length() + 1
-        name = names[k]
-        target = (vec >> (n - 1 - k)) & 1
         steps += r.steps
-        case = {"inputs": _vec(vec, names), "moving": name, "to": int(target)}
+        case = _case(ch, names)
+        found = check_change(r, ch, case["moving"], st, tolerance, mech.ctx.stroke)
+        kinds = sorted({f["kind"] for f in found.failures})
         if record is not None:
             record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation,
                            "max_penetration_mm": r.max_penetration,
@@ -258,48 +315,23 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                            "servo_lag_end_mm": r.servo_lag_end,
                            "held_deviation": {o: float(np.max(np.abs(r.outputs[o] - b)))
                                               for o in spec.outputs if o in r.outputs
-                                              and (b := int(before[o][i])) != DC
-                                              and b == int(after[o][i])}})
-
-        def fail(kind, case=case, **info):
-            counts[kind] += 1
+                                              and (b := ch.before[o]) != DC
+                                              and b == ch.after[o]},
+                           "failure_kinds": kinds})
+        for f in found.failures:
+            counts[f["kind"]] += 1
             if len(failures) < MAX_LISTED:
-                failures.append({"kind": kind, **case, **info})
-
+                failures.append({"kind": f["kind"], **case,
+                                 **{k: v for k, v in f.items() if k != "kind"}})
+        if RECHECKED & set(kinds):
+            failing.append((ch.cur, ch.vec))
         if r.max_violation > max_vio:
             max_vio, worst_joint = r.max_violation, r.worst_joint
         max_pen = max(max_pen, r.max_penetration)
-        if r.max_violation > st.violation_limit or not math.isfinite(r.max_violation):
-            fail("solver", message=f"solver error: joint {r.worst_joint} stretched "
-                 f"{r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
-        if r.max_penetration > st.penetration_limit:
-            fail("contact", message=f"solver error: a contact overrun by {r.max_penetration:.4g}"
-                 f" mm (limit {st.penetration_limit} mm)")
-        if not math.isfinite(r.settle_time):
-            fail("settle", message=f"not settled {st.settle_time} s after the move")
-        else:
+        if math.isfinite(r.settle_time):
             max_settle = max(max_settle, r.settle_time)
-        lag = r.servo_lag_end if hasattr(r, "servo_lag_end") else None
-        if lag is not None and lag > tolerance * mech.ctx.stroke:
-            fail("stall", message=f"input {name} ended {lag:.3g} mm short of its target")
-        for o in spec.outputs:
-            want = int(after[o][i])
-            was = int(before[o][i])
-            got = r.final.get(o)
-            if got is None:
-                continue
-            ref_end = float(r.reference[o][-1]) if o in r.reference else got
-            max_err = max(max_err, abs(got - ref_end))
-            if want != DC:
-                dev = abs(got - want)
-                max_dev = max(max_dev, dev)
-                if dev > tolerance or not math.isfinite(dev):
-                    fail("rest", output=o, expected=want, position=round(got, 6))
-            if want != DC and want == was and o in r.outputs:
-                glitch = float(np.max(np.abs(r.outputs[o] - want)))
-                max_dev = max(max_dev, glitch)
-                if glitch > tolerance:
-                    fail("glitch", output=o, expected=want, max_deviation=round(glitch, 6))
+        max_err = max(max_err, found.error)
+        max_dev = max(max_dev, found.deviation)
     stats = CheckStats(mech)
     sweep(design, lib, samples=5, stats=stats)
     kin_checks = stats.checks() + mech.synthesis_checks()
@@ -311,7 +343,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                              "value": round(c.value, 6), "limit": c.limit,
                              "message": c.text()})
     total_fail = sum(counts.values()) + len(bad_checks)
-    return ProofReport(
+    report = ProofReport(
         level="dynamic", kind="combinational", passed=total_fail == 0, cases=len(vectors),
         coverage={"tour": min(len(vectors), (1 << n) - 1) if n <= 10 else 0,
                   "random_changes": extra, "seed": seed, "tolerance_fraction": tolerance,
@@ -337,7 +369,63 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                                      freeze),
             "settings": st.to_json(),
         },
-        seconds=round(time.perf_counter() - t0, 4))
+        seconds=0.0)
+    if recheck and failing and not one_scene and trace is None:
+        recheck_failures(design, spec, lib, st, report, failing, tolerance, prune=prune,
+                         cells=cells, freeze=freeze, jobs=jobs, scheduler=scheduler,
+                         progress=progress, done_before=len(changes))
+    report.seconds = round(time.perf_counter() - t0, 4)
+    return report
+
+
+def recheck_failures(design: Design, spec: Spec, lib: Library, st: DynSettings,
+                     report: ProofReport, failing: list[tuple[int, int]], tolerance: float,
+                     prune: bool = False, cells: list[str] | None = None,
+                     freeze: str | None = None, jobs: int = 1, scheduler: str | None = None,
+                     progress: Callable[[int, int], None] | None = None,
+                     done_before: int = 0) -> None:
+    """Run the first ``RECHECK_MAX`` distinct ``failing`` changes (from, to vector pairs, in
+    plan order) again at twice ``st``'s iterations, on the same kind of scene, and note in
+    ``report`` what they gave: a joint stretch, contact overrun or late settle that goes away
+    there was the solver's. Each of their failure entries gains ``finer``, the figures gain
+    ``recheck``; the verdict and the failure counts stay the proof's own. ``progress`` goes on
+    from ``done_before`` changes."""
+    distinct = list(dict.fromkeys(failing))
+    chosen = distinct[:RECHECK_MAX]
+    names = list(spec.inputs)
+    finer = replace(st, iterations=2 * st.iterations)
+    types = {c.id: c.cell for c in design.netlist.cells.values()}
+    job = ChangeJob(design, names, types, finer, cells, prune, freeze, None)
+    changes = _changes(spec, names, chosen)
+
+    def tick(done: int, total: int) -> None:
+        if progress is not None:
+            progress(done_before + done, done_before + total)
+
+    runs = [seg[0] for seg in run_cases(run_segment, job, [[c] for c in changes], lib, jobs,
+                                        scheduler, tick, [1] * len(changes))]
+    by_case: dict[str, dict] = {}
+    for ch, run in zip(changes, runs):
+        r = run.result
+        case = _case(ch, names)
+        found = check_change(r, ch, case["moving"], finer, tolerance,
+                             design.mechanism.ctx.stroke)
+        kinds = sorted({f["kind"] for f in found.failures})
+        by_case[repr(case)] = {
+            "iterations": finer.iterations, "passed": not kinds, "failure_kinds": kinds,
+            "max_violation_mm": round(r.max_violation, 6),
+            "max_penetration_mm": round(r.max_penetration, 6),
+            "settle_time_s": round(r.settle_time, 5) if math.isfinite(r.settle_time) else None}
+    for f in report.failures:
+        if "inputs" in f:
+            key = repr({k: f.get(k) for k in ("inputs", "moving", "to")})
+            if key in by_case:
+                f["finer"] = by_case[key]
+    passed = sum(x["passed"] for x in by_case.values())
+    report.figures["recheck"] = {
+        "iterations": finer.iterations, "changes": len(chosen), "passed_finer": passed,
+        "failed_finer": len(chosen) - passed, "not_rechecked": len(distinct) - len(chosen),
+        "cap": RECHECK_MAX}
 
 
 def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
@@ -352,11 +440,14 @@ def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
     st = dyn_settings(design, dt=point.dt, iterations=point.iterations,
                       move_time=point.move_time)
     coarse: list[dict] = []
-    report = prove_dynamic(design, spec, lib, st, record=coarse, trace=trace, **kw)
+    # no re-run at finer settings: the accuracy check chose these, and confirms them below
+    report = prove_dynamic(design, spec, lib, st, record=coarse, trace=trace, recheck=False,
+                           **kw)
     half = replace(st, dt=st.dt / 2)
     fine: list[dict] = []
     kw_half = {k: v for k, v in kw.items() if k != "progress"}
-    prove_dynamic(design, spec, lib, half, record=fine, max_cases=HALVING_CASES, **kw_half)
+    prove_dynamic(design, spec, lib, half, record=fine, max_cases=HALVING_CASES, recheck=False,
+                  **kw_half)
     check = confirm(target, report, coarse[:HALVING_CASES], fine)
     check["chosen"] = {"dt_s": point.dt, "iterations": point.iterations,
                        "move_time_s": point.move_time, "model_error_fraction": point.error,
@@ -369,6 +460,30 @@ def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
             f"(closed form {check['error_vs_closed_form_fraction']:.4g}, step halving "
             f"{check['halving_estimate_fraction']:.4g}) against the requested {target:g}")
     return report
+
+
+def _changes(spec: Spec, names: list[str], pairs: list[tuple[int, int]]) -> list[Change]:
+    """The changes from vector ``cur`` to ``vec``, with the outputs the spec asks for before
+    and after each."""
+    n = len(names)
+
+    def columns(vs: list[int]) -> np.ndarray:
+        return np.array([[(v >> (n - 1 - k)) & 1 for k in range(n)] for v in vs],
+                        dtype=bool).reshape(len(vs), n).T
+
+    before = spec.values_at(columns([cur for cur, _ in pairs]))
+    after = spec.values_at(columns([vec for _, vec in pairs]))
+    return [Change(cur, vec, {o: int(before[o][i]) for o in spec.outputs},
+                   {o: int(after[o][i]) for o in spec.outputs})
+            for i, (cur, vec) in enumerate(pairs)]
+
+
+def _case(ch: Change, names: list[str]) -> dict:
+    """How the report names a change: the inputs after it, the input that moved, and to what."""
+    n = len(names)
+    k = n - (ch.cur ^ ch.vec).bit_length()
+    return {"inputs": _vec(ch.vec, names), "moving": names[k],
+            "to": int((ch.vec >> (n - 1 - k)) & 1)}
 
 
 def _scene_json(scene: Scene | None, sizes: list[tuple[int, int, int]]) -> dict:

@@ -128,7 +128,7 @@ class ProofReport(Mapping):
         lines += ["  " + failure_text(f) for f in self.failures[:SHOWN_FAILURES]]
         if self.failure_count > SHOWN_FAILURES:
             lines.append(f"  ... and {self.failure_count - SHOWN_FAILURES} more (see --report)")
-        lines += solver_hint(r)
+        lines += recheck_text(r) or solver_hint(r)
         lines += timing_text(r)
         hazards = (r.get("sequential") or {}).get("hazards") or []
         if hazards:  # timing the logic cannot remove: what the mechanism must respect
@@ -153,6 +153,32 @@ def solver_hint(r: dict) -> list[str]:
     return ["joint stretch, contact overrun and late settling can be the solver's, not the "
             f"mechanism's: run again with --iterations {2 * it} or --dt {dt / 2:g}; a failure "
             "that goes away there was the solver's"]
+
+
+def recheck_text(r: dict) -> list[str]:
+    """What the re-run of the failing changes at twice the iterations told apart
+    (``mechc.proofs.dynamic.recheck_failures``): a change that passes there failed by the
+    solver; one that still fails is the mechanism's or needs finer settings still. The
+    changes beyond the re-run's cap keep the generic hint."""
+    rc = r.get("recheck")
+    if not rc:
+        return []
+    it, k, ok = rc["iterations"], rc["changes"], rc["passed_finer"]
+    bad = k - ok
+    fails = "fails" if bad == 1 else "fail"
+    parts = [f"{ok} of {k} failing change{'' if k == 1 else 's'} "
+             f"{'passes' if ok == 1 else 'pass'} there"]
+    if ok:
+        parts[0] += f" (the solver's: use --iterations {it})"
+    if bad:
+        who = "(the mechanism's, or the solver's at finer settings still)"
+        parts.append(f"{bad} still {fails} {who}" if ok
+                     else f"{'it' if k == 1 else 'all'} still {fails} {who}")
+    lines = [f"re-run at {it} iterations: " + ", ".join(parts)]
+    if rc.get("not_rechecked"):
+        lines.append(f"{rc['not_rechecked']} more such failing changes were not re-run (at "
+                     f"most {rc['cap']} are): " + " ".join(solver_hint(r)))
+    return lines
 
 
 def timing_text(r: dict) -> list[str]:

@@ -71,7 +71,13 @@ from mechc.ir.spec import Spec
 from mechc.ir.ternary import evaluate3
 from mechc.logic.cubes import DC
 from mechc.physics.scene import DynSettings
-from mechc.proofs.dynamic import dynamic_engine, plan_changes, prove_dynamic
+from mechc.proofs.dynamic import (
+    RECHECKED,
+    dynamic_engine,
+    plan_changes,
+    prove_dynamic,
+    recheck_failures,
+)
 from mechc.proofs.prune import blocker
 from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
@@ -177,8 +183,9 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
         if progress is not None:
             progress(done_before + done, done_before + total)
 
+    # the finer re-run of the failures comes once, after every round (recheck_failures below)
     kw = {"tolerance": settings.tolerance, "extra": settings.cases, "seed": settings.seed,
-          "jobs": settings.jobs, "scheduler": settings.scheduler}
+          "jobs": settings.jobs, "scheduler": settings.scheduler, "recheck": False}
     rep = prove_dynamic(design, spec, lib, st, progress=tick, only=run, record=record, **kw)
     for i, r in zip(run, record):
         decisions[i]["measured_settle_s"] = (round(r["settle_time_s"] + st.move_time, 5)
@@ -191,6 +198,7 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     failures = calibration_failures(decisions, timed, run, record, st, room,
                                     settings.tolerance, stroke)
     bad = [f["text"] for f in failures]
+    ran = list(zip(run, record))  # every change run in pymunk and its record
     fell_back = 0
     while failures:
         # a failing change vouches for nothing: the cleared changes it concerns run, and
@@ -213,11 +221,18 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
             decisions[i]["measured_settle_s"] = (round(r["settle_time_s"] + st.move_time, 5)
                                                  if math.isfinite(r["settle_time_s"]) else None)
         rep = _merge(rep, more)
+        ran += list(zip(again, more_rec))
         run = sorted(run + again)
         fell_back += len(again)
         failures = calibration_failures(decisions, timed, again, more_rec, st, room,
                                         settings.tolerance, stroke)
         bad += [f["text"] for f in failures]
+    failing = [pairs[i] for i, r in sorted(ran, key=lambda x: x[0])
+               if RECHECKED & set(r["failure_kinds"])]
+    if settings.recheck and failing:  # as the dynamic proof does, in plan order
+        recheck_failures(design, spec, lib, st, rep, failing, settings.tolerance,
+                         jobs=settings.jobs, scheduler=settings.scheduler, progress=progress,
+                         done_before=len(run))
     cleared = len(pairs) - len(run)
     text = (f"screen: {len(run)} of {len(pairs)} changes ran in pymunk, {cleared} cleared by "
             f"timing (cleared when predicted settle x {1 + SETTLE_MARGIN:g} <= "
