@@ -130,3 +130,9 @@ def test_no_recheck_on_the_command_line(cli, tmp_path):
     r = json.loads(report.read_text())
     assert code == 1 and "recheck" not in r and not any("finer" in f for f in r["failures"])
     assert "re-run at" not in out and "can be the solver's" in out
+
+
+def test_no_recheck_is_refused_where_no_dynamic_proof_runs(cli):
+    code, _, err = cli("simulate", EXAMPLES / "sorter.bool", "--level", "timing",
+                       "--no-recheck")
+    assert code == 2 and "--no-recheck turns off the re-run" in err and "Traceback" not in err

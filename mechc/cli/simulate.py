@@ -127,6 +127,9 @@ def _check_options(args: argparse.Namespace) -> None:
         raise UsageError("--jobs must be at least 1")
     if args.logic_method != "auto" and args.level != "logic":
         raise UsageError("--logic-method chooses how the logic level checks (--level logic)")
+    if not args.recheck and args.level not in DYNAMIC:
+        raise UsageError("--no-recheck turns off the re-run of a dynamic proof's failing "
+                         "changes (--level dynamic or screened)")
     if args.scheduler is not None and args.level not in DYNAMIC:
         raise UsageError("--scheduler runs the cases of a dynamic proof (--level dynamic or "
                          "screened)")
