@@ -7,7 +7,9 @@ come from the spec's own semantics (``expected_after``), never from the netlist.
 proof fails on: a wrong output at rest, a glitch on an output the step must not change, a
 MEMORY driven by SET and RESET together (the lever binds: reported as an S·R overlap), states
 that keep changing (oscillation), and at the dynamic level the solver checks of
-``mechc.proofs.dynamic`` (joint stretch, contact overrun, settle, stall).
+``mechc.proofs.dynamic`` (joint stretch, contact overrun, settle, stall). As there, the
+steps failing on a kind the solver may cause run again at twice the iterations: here the first
+``RECHECK_MAX`` pieces of walks that hold one, whole (a step's state is its walk's so far).
 """
 
 from __future__ import annotations
