@@ -2,7 +2,9 @@
 again at twice the iterations, and says which failures went away there (the solver's) and
 which did not (the mechanism's); it never changes the verdict. Real failures of the full
 adder: one iteration per step breaks joints (a few changes pass at two), inputs thrown in
-10 ms do not settle (at 60 iterations nor at 120)."""
+10 ms do not settle (at 60 iterations nor at 120). The sequential proof runs its failing
+pieces of walks again (each from power-up) and counts the steps: the gated latch at one
+iteration."""
 
 from __future__ import annotations
 
@@ -12,10 +14,13 @@ import pytest
 
 from mechc.cells.library import load_library
 from mechc.frontends import load_spec
-from mechc.pipeline import compile_spec
+from mechc.frontends.fsm import parse_fsm_file
+from mechc.pipeline import compile_sequential, compile_spec
 from mechc.proofs import ProofSettings, dyn_settings, prove
 from mechc.proofs.dynamic import RECHECK_MAX, RECHECKED, prove_dynamic
 from mechc.proofs.report import ProofReport, recheck_text
+from mechc.proofs.seq_logic import split_walks, transition_tour
+from mechc.proofs.seq_mechanism import prove_sequential_dynamic
 from tests.helpers import EXAMPLES
 
 LIB = load_library()
@@ -136,3 +141,88 @@ def test_no_recheck_is_refused_where_no_dynamic_proof_runs(cli):
     code, _, err = cli("simulate", EXAMPLES / "sorter.bool", "--level", "timing",
                        "--no-recheck")
     assert code == 2 and "--no-recheck turns off the re-run" in err and "Traceback" not in err
+
+
+# ---- the sequential dynamic proof: pieces of walks run again, steps counted -------------------
+# The gated latch at one iteration per step: 42 of its 66 steps (3 of them on the way to a
+# piece's start) break a joint; at two, 20 do. It runs in about 3 s on two processes.
+
+def _step(entry: dict) -> tuple:
+    """A step's identity in a sequential report: walk, step, place on the way to a piece's
+    start (if any), the input moved and to what, the inputs after it."""
+    return (entry["sequence"], entry["step"], entry.get("prefix"), entry["moving"],
+            entry["to"], tuple(sorted(entry["inputs"].items())))
+
+
+def _step_kinds(r: ProofReport) -> dict[tuple, list[str]]:
+    """Each failing step's kinds, from a report that lists every failure."""
+    assert r.failure_count == len(r.failures)
+    out: dict[tuple, set[str]] = {}
+    for f in r.failures:
+        out.setdefault(_step(f), set()).add(f["kind"])
+    return {k: sorted(v) for k, v in out.items()}
+
+
+def _in_piece(key: tuple, p) -> bool:
+    seq, step, prefix = key[:3]
+    return seq == p.walk and (step == p.start if prefix is not None
+                              else p.start < step <= p.end)
+
+
+@pytest.fixture(scope="module")
+def latch():
+    spec = parse_fsm_file(str(EXAMPLES / "gated_latch.fsm"))
+    return compile_sequential(spec, library=LIB), spec
+
+
+def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
+    design, spec = latch
+    st = dyn_settings(design, LIB, iterations=1)
+    seen: list[tuple[int, int]] = []
+    on = prove_sequential_dynamic(design, spec, LIB, st, jobs=2,
+                                  progress=lambda d, t: seen.append((d, t)))
+    off = prove_sequential_dynamic(design, spec, LIB, st, jobs=2, recheck=False)
+    assert _verdict(on) == _verdict(off) and not on.passed
+    assert "recheck" not in off.figures and not any("finer" in f for f in off.failures)
+    failing = {k for k, kinds in _step_kinds(off).items() if RECHECKED & set(kinds)}
+    # the first RECHECK_MAX pieces holding such a step are the ones re-run, whole
+    pieces = split_walks(spec, transition_tour(spec, seed=0, random_walks=2))
+    held = [p for p in pieces if any(_in_piece(k, p) for k in failing)]
+    assert len(held) > RECHECK_MAX
+    chosen = held[:RECHECK_MAX]
+    rechecked = {k for k in failing if any(_in_piece(k, p) for p in chosen)}
+    assert {_step(f) for f in on.failures if "finer" in f} == rechecked
+    assert any(k[2] is not None for k in rechecked)  # a prefix step is matched too
+    # each says what an independent proof at two iterations says of that step
+    truth = _step_kinds(prove_sequential_dynamic(
+        design, spec, LIB, dyn_settings(design, LIB, iterations=2), jobs=2, recheck=False))
+    for f in on.failures:
+        if "finer" in f:
+            want = truth.get(_step(f), [])
+            assert f["finer"]["failure_kinds"] == want and f["finer"]["passed"] == (not want)
+            assert f["finer"]["iterations"] == 2
+    ok = sum(not truth.get(k) for k in rechecked)
+    assert 0 < ok < len(rechecked)  # both kinds of failure, for real
+    assert on.figures["recheck"] == {
+        "iterations": 2, "changes": len(rechecked), "passed_finer": ok,
+        "failed_finer": len(rechecked) - ok, "not_rechecked": len(failing - rechecked),
+        "cap": RECHECK_MAX}
+    text = on.summary_text()
+    assert (f"re-run at 2 iterations: {ok} of {len(rechecked)} failing changes pass there "
+            f"(the solver's: use --iterations 2), {len(rechecked) - ok} still fail") in text
+    assert f"{len(failing - rechecked)} more such failing changes were not re-run" in text
+    # the progress goes on from the proof's steps to the re-run pieces', never back
+    done = [d for d, _ in seen]
+    main = on.cases + on.coverage["prefix_steps"]
+    assert done == sorted(done)
+    assert seen[-1][0] == seen[-1][1] == main + sum(len(p.sequence) - 1 for p in chosen)
+
+
+@pytest.mark.parametrize("recheck", [True, False])
+def test_the_sequential_screened_level_passes_the_setting_on(latch, recheck):
+    design, spec = latch
+    r = prove(design, spec, LIB, "screened", ProofSettings(iterations=1, jobs=2,
+                                                           recheck=recheck))
+    assert not r.passed and r.figures["screen"]["applied"] is False
+    assert ("recheck" in r.figures) == recheck
+    assert any("finer" in f for f in r.failures) == recheck

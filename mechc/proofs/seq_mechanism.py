@@ -7,7 +7,9 @@ come from the spec's own semantics (``expected_after``), never from the netlist.
 proof fails on: a wrong output at rest, a glitch on an output the step must not change, a
 MEMORY driven by SET and RESET together (the lever binds: reported as an S·R overlap), states
 that keep changing (oscillation), and at the dynamic level the solver checks of
-``mechc.proofs.dynamic`` (joint stretch, contact overrun, settle, stall).
+``mechc.proofs.dynamic`` (joint stretch, contact overrun, settle, stall). As there, the
+steps failing on a kind the solver may cause run again at twice the iterations: here the first
+``RECHECK_MAX`` pieces of walks that hold one, whole (a step's state is its walk's so far).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -27,6 +29,7 @@ from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
 from mechc.physics.scene import DynSettings, MoveResult, Scene
+from mechc.proofs.dynamic import RECHECK_MAX, RECHECKED
 from mechc.proofs.parallel import run_cases
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
@@ -269,7 +272,75 @@ def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
     return prove_sequential_dynamic(design, spec, lib, settings=st,
                                     tolerance=settings.tolerance, seed=settings.seed,
                                     progress=progress, trace=settings.trace,
-                                    jobs=settings.jobs, scheduler=settings.scheduler)
+                                    jobs=settings.jobs, scheduler=settings.scheduler,
+                                    recheck=settings.recheck)
+
+
+#: The fields of a failure entry that name its step (``prefix`` only on the way to a piece's
+#: start state).
+WHERE = ("sequence", "step", "prefix", "moving", "to", "inputs")
+
+
+@dataclass
+class _Figures:
+    """The worst of what the steps measured, kept for the report."""
+
+    max_vio: float = 0.0
+    worst: str = ""
+    max_pen: float = 0.0
+    max_err: float = 0.0
+    max_settle: float = 0.0
+    dev: list[float] = field(default_factory=lambda: [0.0])
+
+
+def _where(p: Piece, k: int, seq: list[dict[str, int]], moved: str) -> dict:
+    """How the report names step ``k`` of piece ``p``: its walk and step there (a prefix
+    change: the piece's start step and its place on the way), the input moved, the inputs
+    after it."""
+    where = {"sequence": p.walk, "step": p.start + k - p.prefix, "moving": moved,
+             "to": int(seq[k][moved]), "inputs": {n: int(v) for n, v in seq[k].items()}}
+    if k <= p.prefix:  # on the way to the piece's start state
+        where = {**where, "step": p.start, "prefix": k}
+    return where
+
+
+def _step_key(entry: dict) -> str:
+    """A step's identity from a failure entry or a ``where``: its naming fields."""
+    return repr(sorted((k, entry[k] if k != "inputs" else sorted(entry[k].items()))
+                       for k in WHERE if k in entry))
+
+
+def _judge_step(fails: _Failures, figs: _Figures, where: dict, r: MoveResult,
+                binding: list[str], before: dict, after: dict, st: DynSettings,
+                tolerance: float, stroke: float) -> list[str]:
+    """Every check of one step, the one code path for the proof's run and for the finer
+    re-run of its failing pieces: adds to ``fails`` and ``figs`` and returns the kinds this
+    step failed on (sorted; counted, not only listed)."""
+    was = dict(fails.counts)
+    if r.max_violation > figs.max_vio:
+        figs.max_vio, figs.worst = r.max_violation, r.worst_joint
+    figs.max_pen = max(figs.max_pen, r.max_penetration)
+    if not r.max_violation <= st.violation_limit:
+        fails.add("solver", **where, message=f"solver error: joint {r.worst_joint} "
+                  f"stretched {r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
+    for c in binding:
+        fails.add("S·R overlap", **where, cell=c, message=f"MEMORY {c}: SET and RESET "
+                  "pressed the lever from both sides at once (binds)")
+    if r.max_penetration > st.penetration_limit:
+        fails.add("contact", **where, message=f"a contact overrun by "
+                  f"{r.max_penetration:.4g} mm (limit {st.penetration_limit} mm)")
+    if not math.isfinite(r.settle_time):
+        fails.add("settle", **where, message=f"not settled {st.settle_time} s after")
+    else:
+        figs.max_settle = max(figs.max_settle, r.settle_time)
+    if r.servo_lag_end > tolerance * stroke:
+        fails.add("stall", **where, message=f"input {where['moving']} ended "
+                  f"{r.servo_lag_end:.3g} mm short of its target")
+    for o, got in r.final.items():
+        if o in r.reference:
+            figs.max_err = max(figs.max_err, abs(got - float(r.reference[o][-1])))
+    _judge_outputs(fails, where, r.final, r.outputs, before, after, tolerance, figs.dev)
+    return sorted(k for k, n in fails.counts.items() if n != was.get(k, 0))
 
 
 def prove_sequential_dynamic(design: Design, spec, lib: Library,
@@ -280,7 +351,8 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
                              trace: TraceRecorder | None = None, jobs: int = 1,
                              scheduler: str | None = None,
                              record: list | None = None,
-                             piece_steps: int | None = None) -> ProofReport:
+                             piece_steps: int | None = None,
+                             recheck: bool = True) -> ProofReport:
     """Drive the pymunk scene through the same sequences (or the given input ``sequences``,
     each from the power-up inputs, run whole). A fresh scene starts at power-up for every
     case, so the cases are independent: ``jobs`` processes or the Dask cluster at
@@ -292,7 +364,9 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
     same report. ``record`` (a list) receives each step's figures. Without ``settings``, the
     defaults with the circuit's settle allowance (``dyn_settings``). ``trace`` receives every
     body's pose at power-up and along every step (the walks then run whole, in this
-    process)."""
+    process). ``recheck``: the first ``RECHECK_MAX`` pieces holding a step that failed on a
+    kind the solver may cause run again at twice the iterations (:func:`_recheck_pieces`;
+    not with a trace); it adds to the report, it never changes the verdict."""
     t0 = time.perf_counter()
     mech = design.mechanism
     st = settings or dyn_settings(design, lib)
@@ -304,9 +378,7 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
         pieces = [Piece(wi, 0, len(w) - 1, 0, w) for wi, w in enumerate(walks)]
     fails = _Failures()
     _synthesis_failures(fails, design)
-    dev = [0.0]
-    max_vio = max_pen = max_err = max_settle = 0.0
-    worst = ""
+    figs = _Figures()
     done = prefix_steps = 0
     job = WalkJob(design, _types(design), st, trace)
     wants = [expected_after(spec, p.sequence) for p in pieces]
@@ -315,61 +387,97 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
              for p, want in zip(pieces, wants)]
     if trace is not None:  # the recorder lives in this process: the walks run here
         jobs, scheduler = 1, None
-    results = run_cases(run_walk, job, cases, lib, jobs, scheduler, progress,
-                        [len(p.sequence) - 1 for p in pieces])
-    for p, want, steps in zip(pieces, wants, results):
+    weights = [len(p.sequence) - 1 for p in pieces]
+    results = run_cases(run_walk, job, cases, lib, jobs, scheduler, progress, weights)
+    failing: dict[int, list[str]] = {}  # piece -> its steps a finer solver setting may pass
+    for pi, (p, want, steps) in enumerate(zip(pieces, wants, results)):
         seq = p.sequence
         cur = {k: float(v) for k, v in seq[0].items()}
         for k, (r, binding) in enumerate(steps, start=1):
             moved = next(n for n in seq[k] if seq[k][n] != cur[n])
-            where = {"sequence": p.walk, "step": p.start + k - p.prefix, "moving": moved,
-                     "to": int(seq[k][moved]), "inputs": {n: int(v) for n, v in seq[k].items()}}
-            if k <= p.prefix:  # on the way to the piece's start state
-                where = {**where, "step": p.start, "prefix": k}
+            where = _where(p, k, seq, moved)
             if record is not None:
                 record.append({**where, "final": dict(r.final),
                                "max_violation_mm": r.max_violation,
                                "max_penetration_mm": r.max_penetration,
                                "settle_time_s": r.settle_time, "steps": r.steps,
                                "binding": binding})
-            if r.max_violation > max_vio:
-                max_vio, worst = r.max_violation, r.worst_joint
-            max_pen = max(max_pen, r.max_penetration)
-            if not r.max_violation <= st.violation_limit:
-                fails.add("solver", **where, message=f"solver error: joint {r.worst_joint} "
-                          f"stretched {r.max_violation:.4g} mm (limit {st.violation_limit} mm)")
-            for c in binding:
-                fails.add("S·R overlap", **where, cell=c, message=f"MEMORY {c}: SET and RESET "
-                          "pressed the lever from both sides at once (binds)")
-            if r.max_penetration > st.penetration_limit:
-                fails.add("contact", **where, message=f"a contact overrun by "
-                          f"{r.max_penetration:.4g} mm (limit {st.penetration_limit} mm)")
-            if not math.isfinite(r.settle_time):
-                fails.add("settle", **where, message=f"not settled {st.settle_time} s after")
-            else:
-                max_settle = max(max_settle, r.settle_time)
-            if r.servo_lag_end > tolerance * mech.ctx.stroke:
-                fails.add("stall", **where, message=f"input {moved} ended "
-                          f"{r.servo_lag_end:.3g} mm short of its target")
-            for o, got in r.final.items():
-                if o in r.reference:
-                    max_err = max(max_err, abs(got - float(r.reference[o][-1])))
-            _judge_outputs(fails, where, r.final, r.outputs, want[k - 1], want[k], tolerance,
-                           dev)
+            kinds = _judge_step(fails, figs, where, r, binding, want[k - 1], want[k], st,
+                                tolerance, mech.ctx.stroke)
+            if RECHECKED & set(kinds):
+                failing.setdefault(pi, []).append(_step_key(where))
             cur[moved] = float(seq[k][moved])
             if k <= p.prefix:
                 prefix_steps += 1
             else:
                 done += 1
-    return ProofReport(
+    report = ProofReport(
         level="dynamic", kind="sequential", passed=fails.total == 0, cases=done,
         coverage={"sequences": len(walks), "pieces": len(pieces), "prefix_steps": prefix_steps,
                   "seed": seed, "tolerance_fraction": tolerance},
         failure_count=fails.total, failure_kinds=fails.counts, failures=fails.items,
-        figures={"max_position_error_fraction": round(max_err, 6),
-                 "max_deviation_fraction": round(dev[0], 6),
-                 "min_margin_fraction": round(0.5 - dev[0], 6),
-                 "max_joint_violation_mm": round(max_vio, 6), "worst_joint": worst,
-                 "max_contact_overrun_mm": round(max_pen, 6),
-                 "max_settle_time_s": round(max_settle, 6), "settings": st.to_json()},
-        seconds=round(time.perf_counter() - t0, 3))
+        figures={"max_position_error_fraction": round(figs.max_err, 6),
+                 "max_deviation_fraction": round(figs.dev[0], 6),
+                 "min_margin_fraction": round(0.5 - figs.dev[0], 6),
+                 "max_joint_violation_mm": round(figs.max_vio, 6), "worst_joint": figs.worst,
+                 "max_contact_overrun_mm": round(figs.max_pen, 6),
+                 "max_settle_time_s": round(figs.max_settle, 6), "settings": st.to_json()},
+        seconds=0.0)
+    if recheck and failing and trace is None:
+        _recheck_pieces(design, lib, st, report, pieces, wants, failing, tolerance, jobs,
+                        scheduler, progress, sum(weights))
+    report.seconds = round(time.perf_counter() - t0, 3)
+    return report
+
+
+def _recheck_pieces(design: Design, lib: Library, st: DynSettings, report: ProofReport,
+                    pieces: list[Piece], wants: list[list[dict]],
+                    failing: dict[int, list[str]], tolerance: float, jobs: int,
+                    scheduler: str | None, progress: Callable[[int, int], None] | None,
+                    done_before: int) -> None:
+    """Run the first ``RECHECK_MAX`` ``failing`` pieces (piece index -> the keys of its steps
+    that failed on solver, contact or settle) again, whole and from power-up as before, at
+    twice ``st``'s iterations, and note in ``report`` what their failing steps gave: a step
+    that passes there failed by the solver. A piece runs whole because its state at a step
+    is the walk's up to it. Each failure entry of such a step gains ``finer``; the figures
+    gain ``recheck``, counting steps; the verdict and the failure counts stay the proof's
+    own. ``progress`` goes on from ``done_before`` steps."""
+    chosen = sorted(failing)[:RECHECK_MAX]
+    finer = replace(st, iterations=2 * st.iterations)
+    job = WalkJob(design, _types(design), finer, None)
+    cases = [(pieces[i].walk, pieces[i].sequence, wants[i], []) for i in chosen]
+    weights = [len(pieces[i].sequence) - 1 for i in chosen]
+
+    def tick(done: int, total: int) -> None:
+        if progress is not None:
+            progress(done_before + done, done_before + total)
+
+    results = run_cases(run_walk, job, cases, lib, jobs, scheduler, tick, weights)
+    scratch, figs = _Failures(), _Figures()
+    by_step: dict[str, dict] = {}
+    for i, steps in zip(chosen, results):
+        p, want, keep = pieces[i], wants[i], set(failing[i])
+        seq = p.sequence
+        cur = {k: float(v) for k, v in seq[0].items()}
+        for k, (r, binding) in enumerate(steps, start=1):
+            moved = next(n for n in seq[k] if seq[k][n] != cur[n])
+            where = _where(p, k, seq, moved)
+            kinds = _judge_step(scratch, figs, where, r, binding, want[k - 1], want[k], finer,
+                                tolerance, design.mechanism.ctx.stroke)
+            if (key := _step_key(where)) in keep:
+                by_step[key] = {
+                    "iterations": finer.iterations, "passed": not kinds,
+                    "failure_kinds": kinds, "max_violation_mm": round(r.max_violation, 6),
+                    "max_penetration_mm": round(r.max_penetration, 6),
+                    "settle_time_s": (round(r.settle_time, 5) if math.isfinite(r.settle_time)
+                                      else None)}
+            cur[moved] = float(seq[k][moved])
+    for f in report.failures:
+        if "sequence" in f and (key := _step_key(f)) in by_step:
+            f["finer"] = by_step[key]
+    passed = sum(x["passed"] for x in by_step.values())
+    report.figures["recheck"] = {
+        "iterations": finer.iterations, "changes": len(by_step), "passed_finer": passed,
+        "failed_finer": len(by_step) - passed,
+        "not_rechecked": sum(len(failing[i]) for i in failing if i not in set(chosen)),
+        "cap": RECHECK_MAX}

@@ -38,8 +38,9 @@ class ProofSettings:
     iterations: int | None = None  # dynamic: solver iterations per step
     move_time: float | None = None  # dynamic: seconds an input takes to move
     # dynamic, screened: the changes failing on a joint stretch, contact overrun or late settle
-    # run again at twice the iterations (mechc.proofs.dynamic.recheck_failures); adds to the
-    # report, never changes its verdict
+    # run again at twice the iterations (mechc.proofs.dynamic.recheck_failures; a sequential
+    # design: the pieces of walks holding such a step, mechc.proofs.seq_mechanism); adds to
+    # the report, never changes its verdict
     recheck: bool = True
     # dynamic: processes the cases run on, or the address of a Dask scheduler to run them on
     # (mechc.proofs.parallel); neither changes what the proof reports
