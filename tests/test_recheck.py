@@ -85,7 +85,7 @@ def test_one_iteration_failures_are_told_apart_at_two(adder):
     assert rc["not_rechecked"] == len(failing) - RECHECK_MAX > 0
     text = on.summary_text()
     assert (f"re-run at 2 iterations: {solver_s} of {RECHECK_MAX} failing changes "
-            f"{'passes' if solver_s == 1 else 'pass'} there (the solver's: use --iterations 2), "
+            f"{'passes' if solver_s == 1 else 'pass'} there (the solver's), "
             f"{RECHECK_MAX - solver_s} still fail") in text
     # the changes beyond the cap keep the generic hint
     assert f"{rc['not_rechecked']} more such failing changes were not re-run" in text
@@ -118,9 +118,8 @@ def test_the_recheck_line_reads_plainly():
     rc = {"iterations": 120, "changes": 4, "passed_finer": 3, "failed_finer": 1,
           "not_rechecked": 0, "cap": RECHECK_MAX}
     assert recheck_text({"recheck": rc}) == [
-        "re-run at 120 iterations: 3 of 4 failing changes pass there (the solver's: use "
-        "--iterations 120), 1 still fails (the mechanism's, or the solver's at finer settings "
-        "still)"]
+        "re-run at 120 iterations: 3 of 4 failing changes pass there (the solver's), 1 still "
+        "fails (the mechanism's, or the solver's at finer settings still)"]
     one = {**rc, "changes": 1, "passed_finer": 1, "failed_finer": 0}
     assert recheck_text({"recheck": one}) == [
         "re-run at 120 iterations: 1 of 1 failing change passes there (the solver's: use "
@@ -209,7 +208,7 @@ def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
         "cap": RECHECK_MAX}
     text = on.summary_text()
     assert (f"re-run at 2 iterations: {ok} of {len(rechecked)} failing changes pass there "
-            f"(the solver's: use --iterations 2), {len(rechecked) - ok} still fail") in text
+            f"(the solver's), {len(rechecked) - ok} still fail") in text
     assert f"{len(failing - rechecked)} more such failing changes were not re-run" in text
     # the progress goes on from the proof's steps to the re-run pieces', never back
     done = [d for d, _ in seen]

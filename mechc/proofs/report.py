@@ -168,8 +168,8 @@ def recheck_text(r: dict) -> list[str]:
     fails = "fails" if bad == 1 else "fail"
     parts = [f"{ok} of {k} failing change{'' if k == 1 else 's'} "
              f"{'passes' if ok == 1 else 'pass'} there"]
-    if ok:
-        parts[0] += f" (the solver's: use --iterations {it})"
+    if ok:  # the advice to re-run finer only where it fixed every change re-run
+        parts[0] += (" (the solver's)" if bad else f" (the solver's: use --iterations {it})")
     if bad:
         who = "(the mechanism's, or the solver's at finer settings still)"
         parts.append(f"{bad} still {fails} {who}" if ok
