@@ -18,7 +18,7 @@ from mechc.frontends.fsm import parse_fsm_file
 from mechc.pipeline import compile_sequential, compile_spec
 from mechc.proofs import ProofSettings, dyn_settings, prove
 from mechc.proofs.dynamic import RECHECK_MAX, RECHECKED, prove_dynamic
-from mechc.proofs.report import ProofReport, recheck_text
+from mechc.proofs.report import ProofReport, failure_text, recheck_text
 from mechc.proofs.seq_logic import split_walks, transition_tour
 from mechc.proofs.seq_mechanism import prove_sequential_dynamic
 from tests.helpers import EXAMPLES
@@ -90,6 +90,15 @@ def test_one_iteration_failures_are_told_apart_at_two(adder):
     # the changes beyond the cap keep the generic hint
     assert f"{rc['not_rechecked']} more such failing changes were not re-run" in text
     assert "run again with --iterations 2 or --dt" in text
+    # each listed failure of a re-run change says what the re-run gave; the others say nothing
+    for f in on.failures:
+        line = failure_text(f)
+        if "finer" in f:
+            assert line.endswith("; at 2 iterations: "
+                                 + ("passes" if f["finer"]["passed"] else "still fails"))
+        else:
+            assert "iterations:" not in line
+    assert any(failure_text(f) in text for f in on.failures if "finer" in f)
 
 
 def test_a_settle_failure_of_the_mechanism_still_fails_finer_in_the_screened_proof(adder):

@@ -253,7 +253,12 @@ def failure_text(f: dict) -> str:
                 head += f"{key.replace('_', ' ')} {f[key]} "
     if "message" in f:
         head += f["message"] + " "
-    return head + f"at {ins}"
+    line = head + f"at {ins}"
+    finer = f.get("finer")
+    if finer:  # what the re-run at finer settings gave (mechc.proofs.dynamic.recheck_failures)
+        line += (f"; at {finer['iterations']} iterations: "
+                 + ("passes" if finer["passed"] else "still fails"))
+    return line
 
 
 def accuracy_text(check: dict) -> str:
