@@ -317,3 +317,40 @@ def test_sequential_timing_with_no_requirement_does_not_claim_power_up_only(cli,
     assert "0 ordering requirements" in verdict
     assert "power-up" not in verdict
     assert "no ordering requirement to time" in verdict
+
+
+def test_timing_checks_the_dynamic_proofs_changes_beyond_ten_inputs():
+    """Beyond 10 inputs the dynamic proof starts with the changes that switch every cell; the
+    timing level times those same changes, in the same order, not a walk of its own."""
+    from mechc.frontends.boolfile import parse_bool
+    from mechc.proofs.dynamic import plan_changes
+
+    names = [f"x{i}" for i in range(11)]
+    text = (f"inputs {' '.join(names)}\noutputs y\n"
+            "y = x0 & x1 | x2 & x3 | x4 & x5 | x6 & x7 | x8 & x9 & x10\n")
+    d = compile_spec(parse_bool(text, "<wide>"))
+    rep = prove(d, d.spec, LIB, "timing", ProofSettings())
+    pairs, chosen = plan_changes(d, names, 16, 0, independent=True)
+    assert chosen is not None and rep.cases == len(pairs)
+    n = len(names)
+    for (_, vec), got in zip(pairs, rep.figures["changes"]):
+        assert got["inputs"] == {nm: (vec >> (n - 1 - k)) & 1 for k, nm in enumerate(names)}
+
+
+def test_an_internal_net_settling_after_the_budget_fails_the_change(full_adder, monkeypatch):
+    """Every output in time is not enough: a net still moving after the move and the hold
+    keeps the scene from settling, so the timing level fails that change."""
+    import mechc.proofs.timing as timing
+
+    real = timing.predict_changes
+
+    def late_net(*a, **kw):
+        out = real(*a, **kw)
+        out[0]["nets_settle_s"] = 1.0  # the first change: an internal net far too late
+        return out
+
+    monkeypatch.setattr(timing, "predict_changes", late_net)
+    rep = prove(full_adder, full_adder.spec, LIB, "timing", ProofSettings())
+    assert not rep.passed and rep.failure_kinds == {"settle": 1}
+    assert "an internal net is predicted to settle 1.0000 s" in rep.failures[0]["message"]
+    assert rep.figures["changes"][0]["slack_s"] > 0  # its outputs were in time
