@@ -174,4 +174,7 @@ def test_hazard_step_time_limit_is_reported():
     t = random_table(rng, n, p_on=0.6, p_dc=0.0)
     eq = minimise(spec_of([t], n), MinimiseOptions(hazard_time_limit=0.001, complements=False,
                                                    time_limit=2))
-    assert any(s.startswith("hazard-free cover of") for s in eq.time_limited)
+    # out of time inside the consensus program, or (on a loaded machine) out of wall clock
+    # before it: either way the cover left without its consensus terms is named
+    assert any(s.startswith(("hazard-free cover of", "hazard-free covers of"))
+               for s in eq.time_limited), eq.time_limited
