@@ -53,6 +53,15 @@ class Progress:
                 self.stream.flush()
                 self.shown = True
 
+    def retotal(self, total: int) -> None:
+        """A job that finds more work on the way (a screened proof's fallback round, a
+        re-run of failures) grows its total: the count goes on, and off a terminal the next
+        update prints at once (else the lines would wait for a decile already passed)."""
+        total = max(1, total)
+        if total != self.total:
+            self.total = total
+            self.last_decile = -1
+
     def close(self) -> None:
         if self.shown and self.tty:
             self.stream.write("\n")

@@ -34,6 +34,7 @@ from mechc.frontends import load_spec
 from mechc.pipeline import compile_spec
 from mechc.proofs import prove
 from mechc.proofs.report import sampled_text
+from mechc.ui import Progress
 from tests.helpers import EXAMPLES
 
 
@@ -175,6 +176,25 @@ def test_long_stages_are_named_with_their_seconds():
     time.sleep(0.2)
     st.end("slow", 0.2)
     assert quiet.getvalue() == ""
+
+
+def test_progress_goes_on_when_a_job_finds_more_work():
+    """A screened proof's first round reaches 9/9, then its fallback adds 85 changes: off a
+    terminal (CI logs) the count must go on printing, not wait for a decile already passed."""
+    s = io.StringIO()
+    bar = Progress(9, "proof", delay=0.0, stream=s)
+    for done in range(1, 10):
+        bar.update(done)
+    bar.retotal(94)
+    for done in range(10, 95):
+        bar.update(done)
+    lines = s.getvalue().splitlines()
+    after = [ln for ln in lines if "/94" in ln]
+    assert lines[-1].startswith("proof: 94/94 (100%)")
+    assert len(after) >= 10 and after[0].startswith("proof: 10/94")
+    bar.retotal(94)  # the same total again: no line until the next decile
+    bar.update(94)
+    assert s.getvalue().splitlines() == lines
 
 
 def test_a_design_its_proof_rejects_is_not_written(cli, tmp_path, monkeypatch):

@@ -225,7 +225,7 @@ def prove_written(obj: dict, out: str, args: argparse.Namespace, stages: StagePr
     bar = Progress(1, "compile: kinematic proof", enabled=not args.quiet)
 
     def tick(done: int, total: int) -> None:
-        bar.total = total
+        bar.retotal(total)
         bar.update(done, "states")
 
     stages.start("prove kinematic")

@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
         bar = Progress(1, f"GIF of {Path(args.design).name}")
 
         def drawn(done: int, total: int) -> None:
-            bar.total = total
+            bar.retotal(total)
             bar.update(done, "frames")
 
         try:
@@ -130,7 +130,7 @@ def build_animation(args: argparse.Namespace, design: Design) -> tuple[animation
                 bar = Progress(1, f"{what} proof of {Path(args.design).name}")
 
                 def tick(done: int, total: int, bar=bar) -> None:
-                    bar.total = total
+                    bar.retotal(total)
                     bar.update(done, "input changes")
 
                 report = prove(design, spec, lib, level, settings, tick)
