@@ -214,7 +214,7 @@ def main() -> None:
         if args.only and name not in args.only:
             continue
         spec = design.spec
-        st = dyn_settings(design)
+        st = dyn_settings(design, LIB)
         if args.hold is not None:
             st.settle_time = args.hold
         settings = ProofSettings()

@@ -122,7 +122,7 @@ def main() -> None:
             continue
         spec = design.spec
         names = list(spec.inputs)
-        st = dyn_settings(design)
+        st = dyn_settings(design, LIB)
         vectors = plan(len(names), 16, 0)
         if cases is not None:
             vectors = vectors[:cases]

@@ -11,10 +11,10 @@ from mechc.frontends import load_spec
 from mechc.frontends.fsm import parse_fsm_file
 from mechc.pipeline import compile_sequential, compile_spec
 from mechc.proofs import KINDS, LEVELS, ProofReport, ProofSettings, dyn_settings, prove
+from mechc.proofs.hold import settle_allowance
 from mechc.proofs.logic import prove_logic
 from mechc.proofs.registry import engine
 from mechc.proofs.seq_logic import prove_sequential
-from mechc.proofs.settings import settle_allowance
 from tests.helpers import EXAMPLES
 
 LIB = load_library()

@@ -69,6 +69,13 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
                    help="dynamic: solver iterations per step (default 60)")
     s.add_argument("--move-time", type=finite_float, default=None, metavar="S",
                    help="dynamic: seconds an input takes to move (default 0.08)")
+    s.add_argument("--hold", type=finite_float, default=None, metavar="S",
+                   help="dynamic, screened and timing: seconds each input change is held "
+                   "after its move before the next, the time it has to settle (default: "
+                   "0.15, or longer where the design needs it: 1.5 x a combinational "
+                   "design's static critical path, the longest chain of its cells' "
+                   "characterised delays; a sequential design's memories in turn). Give "
+                   "the time your machine will allow to prove the design at that pace")
     s.add_argument("--no-recheck", dest="recheck", action="store_false",
                    help="dynamic and screened: do not run the changes failing on a joint "
                    "stretch, contact overrun or late settle again at twice the iterations "
@@ -103,7 +110,7 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.set_defaults(func=run)
 
 
-SOLVER_OPTIONS = ("dt", "iterations", "move_time")
+SOLVER_OPTIONS = ("dt", "iterations", "move_time", "hold")
 #: The levels that run pymunk scenes (the screened one on some of the changes).
 DYNAMIC = ("dynamic", "screened")
 
@@ -121,7 +128,7 @@ def _check_options(args: argparse.Namespace) -> None:
     if args.accuracy is not None:
         if not 0 < args.accuracy < 0.5:
             raise UsageError("--accuracy must be between 0 and 0.5 (fraction of stroke)")
-        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
+        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS[:3]):
             raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError("--jobs must be at least 1")
@@ -130,6 +137,9 @@ def _check_options(args: argparse.Namespace) -> None:
     if not args.recheck and args.level not in DYNAMIC:
         raise UsageError("--no-recheck turns off the re-run of a dynamic proof's failing "
                          "changes (--level dynamic or screened)")
+    if args.hold is not None and args.level not in (*DYNAMIC, "timing"):
+        raise UsageError("--hold sets how long a dynamic proof holds each change (--level "
+                         "dynamic, screened or timing)")
     if args.scheduler is not None and args.level not in DYNAMIC:
         raise UsageError("--scheduler runs the cases of a dynamic proof (--level dynamic or "
                          "screened)")
@@ -192,8 +202,8 @@ def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: 
                              logic_method=args.logic_method,
                              prune=args.prune, accuracy=args.accuracy, dt=args.dt,
                              iterations=args.iterations, move_time=args.move_time,
-                             recheck=args.recheck, trace=trace, jobs=args.jobs or available_cores(),
-                             scheduler=args.scheduler)
+                             hold=args.hold, recheck=args.recheck, trace=trace,
+                             jobs=args.jobs or available_cores(), scheduler=args.scheduler)
     if args.level == "logic":
         return prove(design, spec, lib, args.level, settings)
     what = ("sequential " if spec_kind(spec) == "sequential" else "") + args.level
@@ -203,7 +213,7 @@ def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: 
     bar = Progress(1, f"{what} proof of {Path(args.design).name}{where}")
 
     def tick(done: int, total: int) -> None:
-        bar.total = total
+        bar.retotal(total)
         bar.update(done, {"dynamic": "input changes", "screened": "input changes",
                           "timing": "cell measurements"}.get(args.level, "states"))
 

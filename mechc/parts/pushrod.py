@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 import pymunk
 
-from mechc.ir.mechanism import Body, Joint, Part, Point
+from mechc.ir.mechanism import Body, Joint, Mechanism, Part, Point
 from mechc.parts.base import position
 from mechc.parts.link import Link
 from mechc.parts.poses import Poses
@@ -123,3 +123,19 @@ class PushRod(Link):
         moment = pymunk.moment_for_poly(body.mass, [(p[0] - ref[0], p[1] - ref[1])
                                                     for p in poly])
         return pymunk.Body(body.mass, moment)
+
+
+def net_loads(mech: Mechanism) -> dict[str, float]:
+    """Mass (kg) each net's driver moves besides its own output: the net's rods and its
+    loads' input sliders (the load axis of the cells' timing tables)."""
+    index = mech.body_index()
+    out: dict[str, float] = {}
+    for net, part in mech.nets.items():
+        m = 0.0
+        for r in net_rods(part):
+            if r.body is not None and r.body in index:
+                m += index[r.body].mass
+            if r.load in index:
+                m += index[r.load].mass
+        out[net] = m
+    return out

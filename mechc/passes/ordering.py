@@ -49,8 +49,9 @@ from mechc.ir.seqspec import (
 from mechc.passes.amplify import amplifier_cell, amplify_nets
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.scene import DynSettings
+from mechc.proofs.hold import MEMORY_THROW_S
 from mechc.proofs.seq_logic import SeqNetlist, X, _moved, _reachable, path_to, ternary_transition
-from mechc.proofs.settings import MEMORY_THROW_S, dyn_settings
+from mechc.proofs.settings import dyn_settings
 
 #: The time an ordering inequality must hold by (s): a quarter of the default input move.
 MARGIN_S = 0.02

@@ -59,11 +59,16 @@ class DynSettings:
     #                               proof ("solver error"); 0.5 % of the default stroke
     penetration_limit: float = 0.5  # mm: a one-sided contact or stop overrun by more fails it
     record_every: int = 4  # steps between samples of output positions
+    # why settle_time is what it is (mechc.proofs.hold): "default", "static path" (with the
+    # path), "memories" or "--hold"
+    hold_from: str = "default"
+    static_path: dict | None = None
 
     def to_json(self) -> dict:
         return {"dt_s": self.dt, "iterations": self.iterations, "move_time_s": self.move_time,
                 "settle_time_s": self.settle_time, "violation_limit_mm": self.violation_limit,
-                "penetration_limit_mm": self.penetration_limit}
+                "penetration_limit_mm": self.penetration_limit, "hold_from": self.hold_from,
+                **({"static_path": self.static_path} if self.static_path else {})}
 
 
 def min_jerk(tau: np.ndarray | float):

@@ -93,9 +93,9 @@ def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSett
                                    tolerance=settings.tolerance, extra=settings.cases,
                                    seed=settings.seed, progress=progress, prune=settings.prune,
                                    trace=settings.trace, jobs=settings.jobs,
-                                   scheduler=settings.scheduler)
-    st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time)
+                                   scheduler=settings.scheduler, hold=settings.hold)
+    st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time, hold=settings.hold)
     return prove_dynamic(design, spec, lib, st, tolerance=settings.tolerance,
                          extra=settings.cases, seed=settings.seed, progress=progress,
                          prune=settings.prune or PRUNE_DEFAULT, trace=settings.trace,
@@ -255,7 +255,7 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     iterations (:func:`recheck_failures`; not on one scene nor with a trace); it adds to the
     report, it never changes the verdict."""
     t0 = time.perf_counter()
-    st = settings or dyn_settings(design)
+    st = settings or dyn_settings(design, lib)
     if design.mechanism is None:
         raise UsageError("the design has no geometry (compile it with this mechc version)")
     check_interface(design.netlist, spec)
@@ -430,15 +430,15 @@ def recheck_failures(design: Design, spec: Spec, lib: Library, st: DynSettings,
 
 def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
                         model: ErrorModel | None = None, trace: TraceRecorder | None = None,
-                        **kw) -> ProofReport:
+                        hold: float | None = None, **kw) -> ProofReport:
     """``prove_dynamic`` at the cheapest settings meeting ``target``
     (:mod:`mechc.proofs.accuracy`), confirmed on the run; the report says which settings, what
     error was obtained, and fails if it was not met. ``trace`` records the proof's run (not
     the step-halving check's)."""
     model = model or load_model()
     point = choose(target, model)
-    st = dyn_settings(design, dt=point.dt, iterations=point.iterations,
-                      move_time=point.move_time)
+    st = dyn_settings(design, lib, dt=point.dt, iterations=point.iterations,
+                      move_time=point.move_time, hold=hold)
     coarse: list[dict] = []
     # no re-run at finer settings: the accuracy check chose these, and confirms them below
     report = prove_dynamic(design, spec, lib, st, record=coarse, trace=trace, recheck=False,

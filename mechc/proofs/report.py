@@ -129,6 +129,7 @@ class ProofReport(Mapping):
         if self.failure_count > SHOWN_FAILURES:
             lines.append(f"  ... and {self.failure_count - SHOWN_FAILURES} more (see --report)")
         lines += recheck_text(r) or solver_hint(r)
+        lines += hold_text(r)
         lines += timing_text(r)
         hazards = (r.get("sequential") or {}).get("hazards") or []
         if hazards:  # timing the logic cannot remove: what the mechanism must respect
@@ -179,6 +180,29 @@ def recheck_text(r: dict) -> list[str]:
         lines.append(f"{rc['not_rechecked']} more such failing changes were not re-run (at "
                      f"most {rc['cap']} are): " + " ".join(solver_hint(r)))
     return lines
+
+
+def hold_text(r: dict) -> list[str]:
+    """Why a change was held longer than the default before the next one
+    (:mod:`mechc.proofs.hold`): a reader of a settle failure, or a builder timing the
+    machine's inputs, needs to know what the hold was and where it came from."""
+    st = r.get("settings") or {}
+    why, hold = st.get("hold_from"), st.get("settle_time_s")
+    if why in (None, "default") or hold is None:
+        return []
+    if why == "static path":
+        path = st["static_path"]
+        cells = path["cells"]
+        shown = ", ".join(cells) if len(cells) <= 6 else (
+            f"{', '.join(cells[:3])}, ... {', '.join(cells[-2:])}")
+        because = (f"{path['factor']:g} x the design's static critical path, "
+                   f"{path['seconds']:.3f} s through {len(cells)} cell"
+                   f"{'' if len(cells) == 1 else 's'} ({shown})")
+    elif why == "memories":
+        because = "the design's memories, each in turn, may switch after the move"
+    else:
+        because = "as --hold asked"
+    return [f"each change held {hold:.3f} s after its move: {because}"]
 
 
 def timing_text(r: dict) -> list[str]:

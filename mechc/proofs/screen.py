@@ -70,6 +70,7 @@ from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
 from mechc.ir.ternary import evaluate3
 from mechc.logic.cubes import DC
+from mechc.parts.pushrod import net_loads
 from mechc.physics.scene import DynSettings
 from mechc.proofs.dynamic import (
     RECHECKED,
@@ -83,7 +84,7 @@ from mechc.proofs.registry import OnProgress, check_interface, engine
 from mechc.proofs.report import ProofReport
 from mechc.proofs.seq_mechanism import sequential_dynamic_engine
 from mechc.proofs.settings import ProofSettings, dyn_settings
-from mechc.proofs.timing import cell_tables, net_loads, predict_changes
+from mechc.proofs.timing import cell_tables, predict_changes
 
 #: The timing model's worst early prediction of a change's settle (the latest switching net,
 #: what the screen reads; the whole scene settled later than predicted by this share of its
@@ -169,8 +170,8 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     (tests: a hold too short for the circuit)."""
     t0 = time.perf_counter()
     check_interface(design.netlist, spec)
-    st = st or dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
-                            move_time=settings.move_time)
+    st = st or dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
+                            move_time=settings.move_time, hold=settings.hold)
     n = len(spec.inputs)
     pairs, timed, decisions = decide(design, spec, lib, settings, st)
     budget = st.move_time + st.settle_time
@@ -280,7 +281,7 @@ def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st
     after = spec.values_at(_columns([b for _, b in pairs], n))
     held_ok = held_by_logic(nl, names, pairs)
     budget = st.move_time + st.settle_time
-    loads = net_loads(design)
+    loads = net_loads(design.mechanism)
     kind = {c.id: _kind(c, tables.get(c.id)) for c in nl.cells.values()}
     held_margin = HELD_MARGIN_SHARE * settings.tolerance
     decisions: list[dict] = []

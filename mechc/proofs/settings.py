@@ -5,11 +5,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import networkx as nx
-
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.physics.scene import DynSettings
+from mechc.proofs.hold import design_hold
 from mechc.proofs.trace import TraceRecorder
 
 #: A bilateral joint may stretch this share of the stroke before the proof calls it a solver
@@ -17,8 +16,6 @@ from mechc.proofs.trace import TraceRecorder
 VIOLATION_FRACTION = 0.005
 #: The stretch allowed when the design has no geometry to take a stroke from.
 VIOLATION_NO_GEOMETRY_MM = 0.1
-#: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
-MEMORY_THROW_S = 0.03
 #: How the combinational logic level checks every vector (mechc.proofs.logic): ``auto`` picks
 #: ``exhaustive`` or ``sat`` by the design's size; ``sampled`` is a seeded sample, not a proof.
 LOGIC_METHODS = ("auto", "exhaustive", "sat", "sampled")
@@ -37,6 +34,8 @@ class ProofSettings:
     dt: float | None = None  # dynamic: solver time step (s); None: DynSettings' default
     iterations: int | None = None  # dynamic: solver iterations per step
     move_time: float | None = None  # dynamic: seconds an input takes to move
+    hold: float | None = None  # dynamic, screened, timing: seconds each change is held after
+    #                            its move; None: the design's own (mechc.proofs.hold)
     # dynamic, screened: the changes failing on a joint stretch, contact overrun or late settle
     # run again at twice the iterations (mechc.proofs.dynamic.recheck_failures; a sequential
     # design: the pieces of walks holding such a step, mechc.proofs.seq_mechanism); adds to
@@ -52,35 +51,27 @@ class ProofSettings:
 
 
 def dyn_settings(design: Design, lib: Library | None = None, dt: float | None = None,
-                 iterations: int | None = None, move_time: float | None = None) -> DynSettings:
+                 iterations: int | None = None, move_time: float | None = None,
+                 hold: float | None = None) -> DynSettings:
     """The physics settings a dynamic proof of ``design`` uses: joints may stretch
     ``VIOLATION_FRACTION`` of its stroke; the solver options given replace the defaults. With
-    ``lib`` (the sequential proofs) each change is held at least the circuit's
-    :func:`settle_allowance`, so a circuit that is slow by design is not reported unsettled."""
+    ``lib`` each change is held at least as long as the design's structure asks
+    (:func:`mechc.proofs.hold.design_hold`: a combinational design's static critical path, a
+    sequential one's memories in turn), so a circuit that is slow by design is not reported
+    unsettled; ``hold`` (s) replaces that. Without ``lib``: the default hold (the harnesses
+    that measure the physics at fixed settings)."""
     mech = design.mechanism
     st = DynSettings(violation_limit=VIOLATION_FRACTION * mech.ctx.stroke if mech
                      else VIOLATION_NO_GEOMETRY_MM)
     for name, value in (("dt", dt), ("iterations", iterations), ("move_time", move_time)):
         if value is not None:
             setattr(st, name, value)
-    if lib is not None:
-        st.settle_time = max(st.settle_time, settle_allowance(design, lib))
+    if hold is not None:
+        st.settle_time = hold
+        st.hold_from = "--hold"
+    elif lib is not None:
+        why = design_hold(design, lib, st.move_time, st.settle_time)
+        st.settle_time = why["seconds"]
+        st.hold_from = why["from"]
+        st.static_path = why.get("static_path")
     return st
-
-
-def settle_allowance(design: Design, lib: Library) -> float:
-    """How long after an input's move a sequential circuit may still be switching: along the
-    slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
-    transition may pass through every memory in turn. Used as the hold of each change (it
-    still must settle)."""
-    nl = design.netlist
-    g = nl.combinational_graph()
-    delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
-             for c in nl.cells.values()}
-    longest: dict[str, float] = {}
-    for node in nx.topological_sort(g):
-        here = max((longest[u] for u in g.predecessors(node)), default=0.0)
-        longest[node] = here + delay.get(node, 0.0)
-    path = max(longest.values(), default=0.0)
-    m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
-    return 0.1 + (m + 1) * (path + MEMORY_THROW_S)

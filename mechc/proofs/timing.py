@@ -52,15 +52,16 @@ from mechc.ir.mechanism import GROUND
 from mechc.ir.netlist import Netlist
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
-from mechc.parts.pushrod import net_rods
+from mechc.parts.pushrod import net_loads, net_rods
 from mechc.physics.evaluate import evaluate, output_signals, signal_of
 from mechc.physics.scene import DynSettings, min_jerk
 from mechc.proofs.dynamic import plan_changes
+from mechc.proofs.hold import MEMORY_THROW_S
 from mechc.proofs.kinematic import prove_kinematic
 from mechc.proofs.prune import blocker
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
-from mechc.proofs.settings import MEMORY_THROW_S, ProofSettings, dyn_settings
+from mechc.proofs.settings import ProofSettings, dyn_settings
 
 #: Closed-form samples along each input move.
 SAMPLES = 81
@@ -140,23 +141,6 @@ def _switches(nl: Netlist, names: list[str], changes: list[tuple[int, int]]
     return out
 
 
-def net_loads(design: Design) -> dict[str, float]:
-    """Mass (kg) each net's driver moves besides its own output: the net's rods and its
-    loads' input sliders (the load axis of the cells' tables)."""
-    mech = design.mechanism
-    index = mech.body_index()
-    out: dict[str, float] = {}
-    for net, part in mech.nets.items():
-        m = 0.0
-        for r in net_rods(part):
-            if r.body is not None and r.body in index:
-                m += index[r.body].mass
-            if r.load in index:
-                m += index[r.load].mass
-        out[net] = m
-    return out
-
-
 @engine("timing", "combinational")
 def timing_engine(design: Design, spec: Spec, lib: Library, settings: ProofSettings,
                   progress: OnProgress | None) -> ProofReport:
@@ -170,8 +154,8 @@ def prove_timing(design: Design, spec: Spec, lib: Library,
     t0 = time.perf_counter()
     settings = settings or ProofSettings()
     kin = prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed)
-    st = dyn_settings(design, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time)
+    st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
+                      move_time=settings.move_time, hold=settings.hold)
     names = list(spec.inputs)
     # the dynamic proof's changes (beyond 10 inputs: those switching every cell first)
     changes, _chosen = plan_changes(design, names, settings.cases, settings.seed,
@@ -230,6 +214,7 @@ def prove_timing(design: Design, spec: Spec, lib: Library,
             "critical_path": crit_json,
             "budget_s": round(budget, 5),
             "move_time_s": st.move_time,
+            "settings": st.to_json(),
             "cell_tables": {"cells": len(tables), **tabs.found,
                             "untimed": sorted(k for k, v in tables.items() if v is None),
                             "measured_now": measured},
@@ -255,7 +240,7 @@ def predict_changes(design: Design, lib: Library, names: list[str],
     n = len(names)
     ts = sample_times(st.move_time)
     driver = {c.outputs[0]: c for c in nl.cells.values()}
-    loads = net_loads(design)
+    loads = net_loads(design.mechanism)
     figs = {cid: ({**tab.at(st.move_time, loads.get(nl.cells[cid].outputs[0], 0.0)),
                    "as_built": tab.as_built} if tab is not None else None)
             for cid, tab in tables.items()}
@@ -436,9 +421,9 @@ def seq_timing_engine(design: Design, spec: SeqSpec, lib: Library, settings: Pro
     t0 = time.perf_counter()
     tables, _tabs = cell_tables(design, lib, progress)
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time)
+                      move_time=settings.move_time, hold=settings.hold)
     nl = design.netlist
-    loads = net_loads(design)
+    loads = net_loads(design.mechanism)
     delay = {}
     for c in nl.cells.values():
         tab = tables.get(c.id)
@@ -618,7 +603,7 @@ def followers(design: Design, lib: Library) -> dict[str, Follower]:
     its own state, which the cell tables cover instead."""
     mech, nl = design.mechanism, design.netlist
     index = mech.body_index()
-    loads = net_loads(design)
+    loads = net_loads(design.mechanism)
     S, fr = mech.ctx.stroke, mech.ctx.friction
 
     def pressed(body: str, part) -> bool:

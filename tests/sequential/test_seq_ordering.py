@@ -29,9 +29,9 @@ from mechc.passes.ordering import (
 )
 from mechc.physics.scene import DynSettings
 from mechc.pipeline import CompileOptions, assemble_powered, compile_sequential, design_stats
+from mechc.proofs.hold import MEMORY_THROW_S
 from mechc.proofs.seq_logic import prove_sequential
 from mechc.proofs.seq_mechanism import prove_sequential_dynamic, prove_sequential_kinematic
-from mechc.proofs.settings import MEMORY_THROW_S
 from tests.helpers import EXAMPLES
 
 LIB = load_library()
