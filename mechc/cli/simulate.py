@@ -72,7 +72,7 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.add_argument("--hold", type=finite_float, default=None, metavar="S",
                    help="dynamic, screened and timing: seconds each input change is held "
                    "after its move before the next, the time it has to settle (default: "
-                   "0.15, or longer where the design needs it: 1.5 x a combinational "
+                   "0.15, or longer where the design needs it: 2 x a combinational "
                    "design's static critical path, the longest chain of its cells' "
                    "characterised delays; a sequential design's memories in turn). Give "
                    "the time your machine will allow to prove the design at that pace")

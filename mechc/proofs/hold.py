@@ -32,8 +32,10 @@ from mechc.parts.pushrod import net_loads
 
 #: The hold is this many times the static critical path (when that is above the default):
 #: the path's lags are each cell's at the proof's input speed, and a cell driven by a gate
-#: moves its input more slowly than that, so the path is not an upper bound.
-HOLD_FACTOR = 1.5
+#: moves its input more slowly than that, so the path is not an upper bound. Measured
+#: (docs/mechanism.md): the latest settle was 0.92 of the path on a 4-bit adder's 11-cell
+#: chain and 1.47 of it on a 16-bit adder's 58-cell one.
+HOLD_FACTOR = 2.0
 #: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
 MEMORY_THROW_S = 0.03
 _LAGS = ("lag_s", "lag_on_s", "lag_off_s")
