@@ -96,6 +96,26 @@ def test_small_and_sequential_designs_keep_their_holds():
     assert dyn_settings(toggle, LIB).hold_from == "memories"
 
 
+def test_a_cell_that_cannot_be_measured_counts_its_stated_delay(monkeypatch):
+    """A cell too broken to switch alone (the proof after reports it) must not stop the proof
+    deriving its hold: its stated delay stands in, and the report lists it."""
+    from mechc.cells import characterise
+
+    adder = compile_spec(load_spec(EXAMPLES / "full_adder.bool"))
+    broken = sorted(adder.netlist.cells)[0]
+    real = characterise.Tables.get
+
+    def get(self, cell, type_name, n, params, stroke):
+        if (cell, n) == (adder.netlist.cells[broken].cell,
+                         len(adder.netlist.cells[broken].inputs)):
+            raise KeyError("cannot be measured")
+        return real(self, cell, type_name, n, params, stroke)
+
+    monkeypatch.setattr(characterise.Tables, "get", get)
+    st = dyn_settings(adder, LIB)
+    assert broken in st.static_path["untabled"] and st.settle_time == BASE
+
+
 def test_a_deep_chain_settles_within_its_own_hold_not_the_default(adder4):
     """The change the timing level predicts latest, run in pymunk: at the default hold it is
     still moving (or not yet at its outputs) when judged; at the design's hold it passes."""

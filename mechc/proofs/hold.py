@@ -7,11 +7,11 @@ change is held the longer of the default hold (:class:`mechc.physics.scene.DynSe
 what the design's structure asks:
 
 - combinational: :data:`HOLD_FACTOR` times its static critical path (:func:`static_path`): the
-  longest sum through the netlist of each cell's characterised lag (its timing table at the
-  move's input speed and the mass its output net drives, the slower of its two directions, or
-  its stated switching delay if longer) plus the settle extra of the cell it ends in. Static
-  timing analysis: nothing is simulated and every structural path counts, sensitised by a
-  change or not, so it errs long rather than short.
+  longest sum through the netlist of each cell's characterised lag (its timing table shipped
+  with mechc, at the move's input speed and the mass its output net drives, the slower of its
+  two directions, or its stated switching delay if longer) plus the settle extra of the cell
+  it ends in. Static timing analysis: nothing is simulated and every structural path counts,
+  sensitised by a change or not.
 - sequential: :func:`settle_allowance` (a transition may pass through every memory in turn).
 
 Every level that judges settling (dynamic, screened, timing) takes its hold from here, so they
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import networkx as nx
 
-from mechc.cells.characterise import Tables
+from mechc.cells.characterise import UNTIMED, Tables
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.parts.pushrod import net_loads
@@ -49,27 +49,39 @@ class StaticPath:
 
     seconds: float
     cells: tuple[str, ...]
+    untabled: tuple[str, ...] = ()  # cells with no shipped table: their stated delay only
 
     def to_json(self) -> dict:
-        return {"seconds": round(self.seconds, 5), "cells": list(self.cells)}
+        return {"seconds": round(self.seconds, 5), "cells": list(self.cells),
+                "untabled": list(self.untabled)}
 
 
-def static_path(design: Design, lib: Library, move_time: float,
-                tables: Tables | None = None) -> StaticPath:
+def static_path(design: Design, lib: Library, move_time: float) -> StaticPath:
     """The design's static critical path at inputs moved in ``move_time`` (see the module
-    docstring); ``tables`` shares the timing tables another level already holds (a cell with
-    none shipped or cached is measured now, once: cached on disk after)."""
+    docstring). A cell's table is shipped, cached or measured now, as the timing level gets
+    it (:class:`mechc.cells.characterise.Tables`; a measurement is the same wherever it runs,
+    so the hold does not depend on what ran before). A cell that cannot be measured (too
+    broken to switch alone: the proof that follows reports it) counts its stated delay alone
+    and is listed in ``untabled``."""
     nl = design.netlist
     mech = design.mechanism
     if mech is None or not nl.cells:
         return StaticPath(0.0, ())
-    tabs = tables or Tables(lib)
+    tabs = Tables(lib)
     loads = net_loads(mech)
     lag: dict[str, float] = {}
     extra: dict[str, float] = {}
+    untabled = []
     for c in nl.cells.values():
-        stated = float(getattr(lib[c.cell], "switching_delay_s", 0.0) or 0.0)
-        tab = tabs.get(c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke)
+        cls = lib[c.cell]
+        stated = float(getattr(cls, "switching_delay_s", 0.0) or 0.0)
+        timed = not cls.stateful and c.type not in UNTIMED
+        tab = None
+        if timed:
+            try:
+                tab = tabs.get(c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke)
+            except Exception:  # noqa: BLE001 - any failure to measure: stated delay only
+                untabled.append(c.id)
         v = tab.at(move_time, loads.get(c.outputs[0], 0.0)) if tab is not None else {}
         lag[c.id] = max([stated] + [v[k] for k in _LAGS if k in v])
         extra[c.id] = max([0.0] + [v[k] for k in _EXTRAS if k in v])
@@ -87,7 +99,7 @@ def static_path(design: Design, lib: Library, move_time: float,
         if node in nl.cells:
             cells.append(node)
         node = came[node]
-    return StaticPath(arrive[end] + extra[end], tuple(reversed(cells)))
+    return StaticPath(arrive[end] + extra[end], tuple(reversed(cells)), tuple(untabled))
 
 
 def settle_allowance(design: Design, lib: Library) -> float:
@@ -108,8 +120,7 @@ def settle_allowance(design: Design, lib: Library) -> float:
     return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
 
 
-def design_hold(design: Design, lib: Library, move_time: float, base: float,
-                tables: Tables | None = None) -> dict:
+def design_hold(design: Design, lib: Library, move_time: float, base: float) -> dict:
     """The hold a dynamic proof of ``design`` uses by default: ``base`` or longer, and why
     (``{"seconds", "from", "static_path"?}``; ``from`` is ``default``, ``static path`` or
     ``memories``)."""
@@ -118,7 +129,7 @@ def design_hold(design: Design, lib: Library, move_time: float, base: float,
         if need > base:
             return {"seconds": need, "from": "memories"}
         return {"seconds": base, "from": "default"}
-    path = static_path(design, lib, move_time, tables)
+    path = static_path(design, lib, move_time)
     need = HOLD_FACTOR * path.seconds
     out = {"seconds": base, "from": "default",
            "static_path": {**path.to_json(), "factor": HOLD_FACTOR}}

@@ -198,6 +198,9 @@ def hold_text(r: dict) -> list[str]:
         because = (f"{path['factor']:g} x the design's static critical path, "
                    f"{path['seconds']:.3f} s through {len(cells)} cell"
                    f"{'' if len(cells) == 1 else 's'} ({shown})")
+        if path.get("untabled"):
+            because += (f"; {len(path['untabled'])} cells that could not be measured "
+                        "counted at their stated delay")
     elif why == "memories":
         because = "the design's memories, each in turn, may switch after the move"
     else:
