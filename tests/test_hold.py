@@ -134,6 +134,14 @@ def test_a_deep_chain_settles_within_its_own_hold_not_the_default(adder4):
     assert fine.passed, fine.failures
 
 
+def test_a_settle_failure_names_the_hold():
+    r = run_subprocess("simulate", EXAMPLES / "full_adder.bool", "--level", "dynamic",
+                       "--move-time", "0.01", "--no-recheck")
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "still moving when the 0.150 s hold ran out" in r.stdout
+    assert "longer --hold S" in r.stdout
+
+
 def test_cli_hold_option(tmp_path):
     r = run_subprocess("simulate", EXAMPLES / "sorter.bool", "--level", "logic", "--hold", "0.3")
     assert r.returncode == 2 and "--hold" in r.stderr and "Traceback" not in r.stderr

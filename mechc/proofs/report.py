@@ -188,8 +188,14 @@ def hold_text(r: dict) -> list[str]:
     machine's inputs, needs to know what the hold was and where it came from."""
     st = r.get("settings") or {}
     why, hold = st.get("hold_from"), st.get("settle_time_s")
-    if why in (None, "default") or hold is None:
+    if hold is None:
         return []
+    late = (r.get("failure_kinds") or {}).get("settle", 0)
+    slow = ([f"{late} change{' was' if late == 1 else 's were'} still moving when the "
+             f"{hold:.3f} s hold ran out: one that is only slow settles with a longer --hold S, "
+             "one that never comes to rest does not"] if late else [])
+    if why in (None, "default"):
+        return slow
     if why == "static path":
         path = st["static_path"]
         cells = path["cells"]
@@ -205,7 +211,7 @@ def hold_text(r: dict) -> list[str]:
         because = "the design's memories, each in turn, may switch after the move"
     else:
         because = "as --hold asked"
-    return [f"each change held {hold:.3f} s after its move: {because}"]
+    return [f"each change held {hold:.3f} s after its move: {because}", *slow]
 
 
 def timing_text(r: dict) -> list[str]:
