@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import networkx as nx
 
-from mechc.cells.characterise import UNTIMED, Tables
+from mechc.cells.characterise import Tables
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.parts.pushrod import net_loads
@@ -73,15 +73,12 @@ def static_path(design: Design, lib: Library, move_time: float) -> StaticPath:
     extra: dict[str, float] = {}
     untabled = []
     for c in nl.cells.values():
-        cls = lib[c.cell]
-        stated = float(getattr(cls, "switching_delay_s", 0.0) or 0.0)
-        timed = not cls.stateful and c.type not in UNTIMED
-        tab = None
-        if timed:
-            try:
-                tab = tabs.get(c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke)
-            except Exception:  # noqa: BLE001 - any failure to measure: stated delay only
-                untabled.append(c.id)
+        stated = float(getattr(lib[c.cell], "switching_delay_s", 0.0) or 0.0)
+        tab = None  # a memory or a constant has none (Tables.get)
+        try:
+            tab = tabs.get(c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke)
+        except Exception:  # noqa: BLE001 - any failure to measure: stated delay only
+            untabled.append(c.id)
         v = tab.at(move_time, loads.get(c.outputs[0], 0.0)) if tab is not None else {}
         lag[c.id] = max([stated] + [v[k] for k in _LAGS if k in v])
         extra[c.id] = max([0.0] + [v[k] for k in _EXTRAS if k in v])
