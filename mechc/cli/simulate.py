@@ -110,7 +110,8 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.set_defaults(func=run)
 
 
-SOLVER_OPTIONS = ("dt", "iterations", "move_time", "hold")
+#: What --accuracy chooses; with --hold, the options that must be positive.
+SOLVER_OPTIONS = ("dt", "iterations", "move_time")
 #: The levels that run pymunk scenes (the screened one on some of the changes).
 DYNAMIC = ("dynamic", "screened")
 
@@ -121,14 +122,14 @@ def _check_options(args: argparse.Namespace) -> None:
         raise UsageError("--tolerance must be between 0 and 0.5")
     if args.cases < 0:
         raise UsageError("--cases must not be negative")
-    for opt in SOLVER_OPTIONS:
+    for opt in (*SOLVER_OPTIONS, "hold"):
         v = getattr(args, opt)
         if v is not None and v <= 0:
             raise UsageError(f"--{opt.replace('_', '-')} must be positive")
     if args.accuracy is not None:
         if not 0 < args.accuracy < 0.5:
             raise UsageError("--accuracy must be between 0 and 0.5 (fraction of stroke)")
-        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS[:3]):
+        if any(getattr(args, o) is not None for o in SOLVER_OPTIONS):
             raise UsageError("--accuracy chooses --dt, --iterations and --move-time")
     if args.jobs is not None and args.jobs < 1:
         raise UsageError("--jobs must be at least 1")

@@ -82,13 +82,7 @@ def static_path(design: Design, lib: Library, move_time: float) -> StaticPath:
         v = tab.at(move_time, loads.get(c.outputs[0], 0.0)) if tab is not None else {}
         lag[c.id] = max([stated] + [v[k] for k in _LAGS if k in v])
         extra[c.id] = max([0.0] + [v[k] for k in _EXTRAS if k in v])
-    arrive: dict[str, float] = {}
-    came: dict[str, str | None] = {}
-    g = nl.combinational_graph()
-    for node in nx.topological_sort(g):
-        before = max(g.predecessors(node), key=lambda u: arrive[u], default=None)
-        arrive[node] = (arrive[before] if before is not None else 0.0) + lag.get(node, 0.0)
-        came[node] = before
+    arrive, came = _latest(nl.combinational_graph(), lag)
     end = max(nl.cells, key=lambda c: (arrive[c] + extra[c], c))
     cells = []
     node: str | None = end
@@ -99,20 +93,29 @@ def static_path(design: Design, lib: Library, move_time: float) -> StaticPath:
     return StaticPath(arrive[end] + extra[end], tuple(reversed(cells)), tuple(untabled))
 
 
+def _latest(g: nx.MultiDiGraph, delay: dict[str, float]
+            ) -> tuple[dict[str, float], dict[str, str | None]]:
+    """Every node's latest arrival in the acyclic graph ``g`` (the slowest chain of
+    ``delay`` from a source, its own delay included) and the node that chain came through."""
+    arrive: dict[str, float] = {}
+    came: dict[str, str | None] = {}
+    for node in nx.topological_sort(g):
+        before = max(g.predecessors(node), key=lambda u: arrive[u], default=None)
+        arrive[node] = (arrive[before] if before is not None else 0.0) + delay.get(node, 0.0)
+        came[node] = before
+    return arrive, came
+
+
 def settle_allowance(design: Design, lib: Library) -> float:
     """How long after an input's move a sequential circuit may still be switching: along the
     slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
     transition may pass through every memory in turn. Used as the hold of each change (it
     still must settle)."""
     nl = design.netlist
-    g = nl.combinational_graph()
     delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
              for c in nl.cells.values()}
-    longest: dict[str, float] = {}
-    for node in nx.topological_sort(g):
-        here = max((longest[u] for u in g.predecessors(node)), default=0.0)
-        longest[node] = here + delay.get(node, 0.0)
-    path = max(longest.values(), default=0.0)
+    arrive, _came = _latest(nl.combinational_graph(), delay)
+    path = max(arrive.values(), default=0.0)
     m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
     return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
 
