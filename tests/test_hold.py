@@ -152,3 +152,33 @@ def test_cli_hold_option(tmp_path):
     assert r.returncode == 0, r.stdout + r.stderr
     assert "each change held 0.300 s after its move: as --hold asked" in r.stdout
     assert "budget 0.380 s" in r.stdout
+
+
+def test_a_table_measured_for_the_hold_shows_progress(tmp_path, monkeypatch):
+    """A cell with no shipped table is measured on first use before the proof's first change
+    (seconds per cell, 12 s for random81's): the proof's progress is told so, naming the cell,
+    and the CLI prints it; with the table cached, nothing is measured again."""
+    monkeypatch.setenv("MECHC_CACHE_DIR", str(tmp_path))
+    spec = tmp_path / "and4.bool"
+    spec.write_text("inputs a b c d\noutputs z\nz = a & b & c & d\n")
+    d = compile_spec(load_spec(spec))
+    assert any(len(c.inputs) == 4 for c in d.netlist.cells.values())  # not shipped
+    seen: list[tuple] = []
+    from mechc.proofs import prove
+
+    rep = prove(d, d.spec, LIB, "dynamic", ProofSettings(jobs=1),
+                lambda done, total, *what: seen.append((done, total, *what)))
+    assert rep.passed, rep.failures[:3]
+    measuring = [s for s in seen if len(s) == 3]
+    changes = [s for s in seen if len(s) == 2]
+    assert measuring and changes and seen.index(measuring[-1]) < seen.index(changes[0])
+    assert measuring[-1][0] == measuring[-1][1] and "(first use)" in measuring[-1][2]
+    assert any(f"'{c.cell}'" in measuring[-1][2] for c in d.netlist.cells.values())
+    seen.clear()
+    dyn_settings(d, LIB, progress=lambda *a: seen.append(a))
+    assert not seen  # cached now
+
+    monkeypatch.setenv("MECHC_CACHE_DIR", str(tmp_path / "empty"))
+    r = run_subprocess("simulate", spec, "--level", "dynamic", "--jobs", "1")
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "measuring the timing of cell 'and' (first use)" in r.stderr

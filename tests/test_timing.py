@@ -110,10 +110,11 @@ def test_cell_not_shipped_is_measured_once_then_read_from_the_cache(tmp_path, mo
     nl.set_output("z", "z")
     spec = load_spec_text("inputs a b c d\noutputs z\nz = a & b & c & d\n")
     d = compile_netlist(spec, nl, library=LIB)
-    seen: list[tuple[int, int]] = []
-    first, tabs = cell_tables(d, LIB, lambda a, b: seen.append((a, b)))
+    seen: list[tuple] = []
+    first, tabs = cell_tables(d, LIB, lambda a, b, *what: seen.append((a, b, *what)))
     assert tabs.found == {"shipped": 0, "cached": 0, "measured": 1}
-    assert seen[-1] == (9, 9) and len(list(tmp_path.iterdir())) == 1  # progress, one file
+    assert seen[-1] == (9, 9, "measuring the timing of cell 'and' (first use)")  # named
+    assert len(list(tmp_path.iterdir())) == 1  # one file
     again, tabs2 = cell_tables(d, LIB, None)
     assert tabs2.found == {"shipped": 0, "cached": 1, "measured": 0}
     assert again["g"].values == first["g"].values

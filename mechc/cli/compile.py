@@ -224,9 +224,9 @@ def prove_written(obj: dict, out: str, args: argparse.Namespace, stages: StagePr
         return results
     bar = Progress(1, "compile: kinematic proof", enabled=not args.quiet)
 
-    def tick(done: int, total: int) -> None:
+    def tick(done: int, total: int, what: str = "") -> None:
         bar.retotal(total)
-        bar.update(done, "states")
+        bar.update(done, what or "states")
 
     stages.start("prove kinematic")
     try:

@@ -129,9 +129,9 @@ def build_animation(args: argparse.Namespace, design: Design) -> tuple[animation
                         else "dynamic")
                 bar = Progress(1, f"{what} proof of {Path(args.design).name}")
 
-                def tick(done: int, total: int, bar=bar) -> None:
+                def tick(done: int, total: int, what: str = "", bar=bar) -> None:
                     bar.retotal(total)
-                    bar.update(done, "input changes")
+                    bar.update(done, what or "input changes")
 
                 report = prove(design, spec, lib, level, settings, tick)
             else:

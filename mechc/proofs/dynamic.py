@@ -95,7 +95,8 @@ def dynamic_engine(design: Design, spec: Spec, lib: Library, settings: ProofSett
                                    trace=settings.trace, jobs=settings.jobs,
                                    scheduler=settings.scheduler, hold=settings.hold)
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time, hold=settings.hold)
+                      move_time=settings.move_time, hold=settings.hold,
+                      progress=progress)
     return prove_dynamic(design, spec, lib, st, tolerance=settings.tolerance,
                          extra=settings.cases, seed=settings.seed, progress=progress,
                          prune=settings.prune or PRUNE_DEFAULT, trace=settings.trace,
@@ -438,7 +439,7 @@ def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,
     model = model or load_model()
     point = choose(target, model)
     st = dyn_settings(design, lib, dt=point.dt, iterations=point.iterations,
-                      move_time=point.move_time, hold=hold)
+                      move_time=point.move_time, hold=hold, progress=kw.get("progress"))
     coarse: list[dict] = []
     # no re-run at finer settings: the accuracy check chose these, and confirms them below
     report = prove_dynamic(design, spec, lib, st, record=coarse, trace=trace, recheck=False,

@@ -21,6 +21,7 @@ change that settles early (the run stops once every body is still).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import networkx as nx
@@ -56,18 +57,22 @@ class StaticPath:
                 "untabled": list(self.untabled)}
 
 
-def static_path(design: Design, lib: Library, move_time: float) -> StaticPath:
+def static_path(design: Design, lib: Library, move_time: float,
+                progress: Callable[..., None] | None = None) -> StaticPath:
     """The design's static critical path at inputs moved in ``move_time`` (see the module
     docstring). A cell's table is shipped, cached or measured now, as the timing level gets
     it (:class:`mechc.cells.characterise.Tables`; a measurement is the same wherever it runs,
     so the hold does not depend on what ran before). A cell that cannot be measured (too
     broken to switch alone: the proof that follows reports it) counts its stated delay alone
-    and is listed in ``untabled``."""
+    and is listed in ``untabled``. ``progress`` is told (done, total, what) while a cell's
+    table is measured (the first use of a cell on this machine: seconds per cell)."""
     nl = design.netlist
     mech = design.mechanism
     if mech is None or not nl.cells:
         return StaticPath(0.0, ())
-    tabs = Tables(lib)
+    tabs = Tables(lib, None if progress is None else (
+        lambda cell, done, total: progress(done, total, f"measuring the timing of cell "
+                                                        f"{cell!r} (first use)")))
     loads = net_loads(mech)
     lag: dict[str, float] = {}
     extra: dict[str, float] = {}
@@ -120,16 +125,17 @@ def settle_allowance(design: Design, lib: Library) -> float:
     return 0.1 + (m + 1) * (path + MEMORY_THROW_S)
 
 
-def design_hold(design: Design, lib: Library, move_time: float, base: float) -> dict:
+def design_hold(design: Design, lib: Library, move_time: float, base: float,
+                progress: Callable[..., None] | None = None) -> dict:
     """The hold a dynamic proof of ``design`` uses by default: ``base`` or longer, and why
     (``{"seconds", "from", "static_path"?}``; ``from`` is ``default``, ``static path`` or
-    ``memories``)."""
+    ``memories``); ``progress`` as for :func:`static_path`."""
     if design.netlist.state_nets():
         need = settle_allowance(design, lib)
         if need > base:
             return {"seconds": need, "from": "memories"}
         return {"seconds": base, "from": "default"}
-    path = static_path(design, lib, move_time)
+    path = static_path(design, lib, move_time, progress)
     need = HOLD_FACTOR * path.seconds
     out = {"seconds": base, "from": "default",
            "static_path": {**path.to_json(), "factor": HOLD_FACTOR}}

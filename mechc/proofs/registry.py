@@ -19,8 +19,10 @@ from mechc.proofs.settings import ProofSettings
 
 LEVELS = ("logic", "kinematic", "dynamic", "timing", "screened")
 KINDS = ("combinational", "sequential")
-#: Called as (done, total) while a long proof runs.
-OnProgress = Callable[[int, int], None]
+#: Called as (done, total) while a long proof runs, in the level's own unit (input changes,
+#: states); as (done, total, what) for other work on the way that takes a while, ``what``
+#: naming it (a cell's timing table measured on first use).
+OnProgress = Callable[..., None]
 Engine = Callable[[Design, Spec | SeqSpec, Library, ProofSettings, OnProgress | None], ProofReport]
 
 _ENGINES: dict[tuple[str, str], Engine] = {}

@@ -171,7 +171,8 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     t0 = time.perf_counter()
     check_interface(design.netlist, spec)
     st = st or dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
-                            move_time=settings.move_time, hold=settings.hold)
+                            move_time=settings.move_time, hold=settings.hold,
+                            progress=progress)
     n = len(spec.inputs)
     pairs, timed, decisions = decide(design, spec, lib, settings, st)
     budget = st.move_time + st.settle_time

@@ -268,7 +268,8 @@ def sequential_dynamic_engine(design: Design, spec: SeqSpec, lib: Library,
                               settings: ProofSettings,
                               progress: OnProgress | None) -> ProofReport:
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time, hold=settings.hold)
+                      move_time=settings.move_time, hold=settings.hold,
+                      progress=progress)
     return prove_sequential_dynamic(design, spec, lib, settings=st,
                                     tolerance=settings.tolerance, seed=settings.seed,
                                     progress=progress, trace=settings.trace,

@@ -3,6 +3,7 @@ proof runs at unless told otherwise (:func:`dyn_settings`)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from mechc.cells.library import Library
@@ -52,14 +53,16 @@ class ProofSettings:
 
 def dyn_settings(design: Design, lib: Library | None = None, dt: float | None = None,
                  iterations: int | None = None, move_time: float | None = None,
-                 hold: float | None = None) -> DynSettings:
+                 hold: float | None = None,
+                 progress: Callable[..., None] | None = None) -> DynSettings:
     """The physics settings a dynamic proof of ``design`` uses: joints may stretch
     ``VIOLATION_FRACTION`` of its stroke; the solver options given replace the defaults. With
     ``lib`` each change is held at least as long as the design's structure asks
     (:func:`mechc.proofs.hold.design_hold`: a combinational design's static critical path, a
     sequential one's memories in turn), so a circuit that is slow by design is not reported
     unsettled; ``hold`` (s) replaces that. Without ``lib``: the default hold (the harnesses
-    that measure the physics at fixed settings)."""
+    that measure the physics at fixed settings). ``progress`` is told (done, total, what)
+    while a cell's timing table is measured for the hold (first use on a machine)."""
     mech = design.mechanism
     st = DynSettings(violation_limit=VIOLATION_FRACTION * mech.ctx.stroke if mech
                      else VIOLATION_NO_GEOMETRY_MM)
@@ -70,7 +73,7 @@ def dyn_settings(design: Design, lib: Library | None = None, dt: float | None = 
         st.settle_time = hold
         st.hold_from = "--hold"
     elif lib is not None:
-        why = design_hold(design, lib, st.move_time, st.settle_time)
+        why = design_hold(design, lib, st.move_time, st.settle_time, progress)
         st.settle_time = why["seconds"]
         st.hold_from = why["from"]
         st.static_path = why.get("static_path")

@@ -104,9 +104,9 @@ def cell_tables(design: Design, lib: Library, progress: OnProgress | None,
                             names[k], float((vec >> (n - 1 - k)) & 1)))
         return out
 
-    def tick(_cell: str, done: int, total: int) -> None:
+    def tick(cell: str, done: int, total: int) -> None:
         if progress is not None:
-            progress(done, total)
+            progress(done, total, f"measuring the timing of cell {cell!r} (first use)")
 
     tabs = Tables(lib, tick)
     out: dict[str, CellTable | None] = {}
@@ -155,7 +155,8 @@ def prove_timing(design: Design, spec: Spec, lib: Library,
     settings = settings or ProofSettings()
     kin = prove_kinematic(design, spec, lib, tolerance=settings.tolerance, seed=settings.seed)
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time, hold=settings.hold)
+                      move_time=settings.move_time, hold=settings.hold,
+                      progress=progress)
     names = list(spec.inputs)
     # the dynamic proof's changes (beyond 10 inputs: those switching every cell first)
     changes, _chosen = plan_changes(design, names, settings.cases, settings.seed,
@@ -421,7 +422,8 @@ def seq_timing_engine(design: Design, spec: SeqSpec, lib: Library, settings: Pro
     t0 = time.perf_counter()
     tables, _tabs = cell_tables(design, lib, progress)
     st = dyn_settings(design, lib, dt=settings.dt, iterations=settings.iterations,
-                      move_time=settings.move_time, hold=settings.hold)
+                      move_time=settings.move_time, hold=settings.hold,
+                      progress=progress)
     nl = design.netlist
     loads = net_loads(design.mechanism)
     delay = {}
