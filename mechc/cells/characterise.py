@@ -41,10 +41,11 @@ import numpy as np
 from mechc.cells.cell import Cell
 from mechc.cells.library import Library
 from mechc.cells.prove_cell import alone
-from mechc.physics.scene import DynSettings, Scene
+from mechc.parts.poses import Poses
+from mechc.physics.scene import MOVE_SAMPLES, DynSettings, Scene
 
 #: Bump when what is measured or how changes: older tables are then measured again.
-VERSION = 3
+VERSION = 4
 #: Input move times (s) of the grid: 2x faster and 2x slower than the proofs' default 0.08 s.
 MOVE_TIMES = (0.04, 0.08, 0.16)
 #: Masses (kg) added to the output body: none, about one load's slider and rod, about three.
@@ -61,6 +62,10 @@ FIGURES = ("lag_s", "settle_extra_s", "overshoot", "force_N")
 #: the other lags differently each way; ``lag_s`` is the worse of the two). A table without
 #: them (an older one) serves both directions with the worse.
 DIRECTED = ("lag_s", "settle_extra_s")
+#: Times (s) from the output's mid-stroke crossing at which a cell's *landing* is kept: its
+#: output's share of the way from start to end (``CellTable.shapes``). A cell timed as built
+#: (an amplifier) is a step in the closed form; what follows it is driven by this shape.
+SHAPE_T = tuple(round(-0.06 + 0.005 * k, 3) for k in range(63))
 
 #: Called as (done, total) while a cell is measured.
 OnProgress = Callable[[int, int], None]
@@ -83,24 +88,27 @@ class CellTable:
     seconds: float = 0.0
     sha: str = ""  # the cell file's SHA-256 when it was measured
     as_built: bool = False  # measured on the cell as a design built it (not compiled alone)
+    #: per direction ("on", "off"): a (move times x loads) grid of the output's landing, its
+    #: share of the way at each of ``SHAPE_T`` from its crossing (None: not measured)
+    shapes: dict[str, list[list[list[float]]]] | None = None
 
     def at(self, move_time: float, load: float) -> dict[str, float]:
         """Every figure at ``move_time`` and ``load``, bilinear between grid points and held
         at the grid's edge outside it (a cell is never extrapolated)."""
-        mt = np.asarray(self.move_times, dtype=float)
-        ld = np.asarray(self.loads, dtype=float)
-        x = float(np.clip(move_time, mt[0], mt[-1]))
-        y = float(np.clip(load, ld[0], ld[-1]))
-        i = int(np.clip(np.searchsorted(mt, x) - 1, 0, len(mt) - 2))
-        j = int(np.clip(np.searchsorted(ld, y) - 1, 0, len(ld) - 2))
-        fx = (x - mt[i]) / (mt[i + 1] - mt[i])
-        fy = (y - ld[j]) / (ld[j + 1] - ld[j])
-        out = {}
-        for name, grid in self.values.items():
-            g = np.asarray(grid, dtype=float)
-            out[name] = float((1 - fx) * (1 - fy) * g[i, j] + fx * (1 - fy) * g[i + 1, j]
-                              + (1 - fx) * fy * g[i, j + 1] + fx * fy * g[i + 1, j + 1])
-        return out
+        w = _weights(self.move_times, self.loads, move_time, load)
+        return {name: float(sum(f * grid[i][j] for (i, j), f in w))
+                for name, grid in self.values.items()}
+
+    def shape(self, on: bool, move_time: float, load: float) -> np.ndarray | None:
+        """The output's landing switching ``on`` (or off) at ``move_time`` and ``load``, at
+        each of ``SHAPE_T`` from its crossing; bilinear between grid points as :meth:`at`
+        (None when the table has none)."""
+        if not self.shapes:
+            return None
+        # a way no move measured lands like the other (a table shared by geometry)
+        grid = self.shapes.get("on" if on else "off") or next(iter(self.shapes.values()))
+        w = _weights(self.move_times, self.loads, move_time, load)
+        return sum(f * np.asarray(grid[i][j], dtype=float) for (i, j), f in w)
 
     def to_json(self) -> dict:
         return {"key": self.key, "cell": self.cell, "type": self.type, "n": self.n,
@@ -108,7 +116,8 @@ class CellTable:
                 "move_times_s": list(self.move_times), "loads_kg": list(self.loads),
                 "values": self.values, "changes": self.changes,
                 "seconds": round(self.seconds, 3), "source_sha256": self.sha,
-                "as_built": self.as_built}
+                "as_built": self.as_built,
+                **({"shapes": self.shapes} if self.shapes is not None else {})}
 
     @staticmethod
     def from_json(d: dict) -> CellTable:
@@ -116,7 +125,24 @@ class CellTable:
                          float(d["stroke"]), tuple(d["move_times_s"]), tuple(d["loads_kg"]),
                          {k: [list(map(float, r)) for r in v] for k, v in d["values"].items()},
                          int(d["changes"]), float(d.get("seconds", 0.0)),
-                         d.get("source_sha256", ""), bool(d.get("as_built", False)))
+                         d.get("source_sha256", ""), bool(d.get("as_built", False)),
+                         d.get("shapes"))
+
+
+def _weights(move_times, loads, move_time: float, load: float
+             ) -> list[tuple[tuple[int, int], float]]:
+    """The grid points and weights of a bilinear read-out at (``move_time``, ``load``), held
+    at the grid's edge outside it."""
+    mt = np.asarray(move_times, dtype=float)
+    ld = np.asarray(loads, dtype=float)
+    x = float(np.clip(move_time, mt[0], mt[-1]))
+    y = float(np.clip(load, ld[0], ld[-1]))
+    i = int(np.clip(np.searchsorted(mt, x) - 1, 0, len(mt) - 2))
+    j = int(np.clip(np.searchsorted(ld, y) - 1, 0, len(ld) - 2))
+    fx = (x - mt[i]) / (mt[i + 1] - mt[i])
+    fy = (y - ld[j]) / (ld[j + 1] - ld[j])
+    return [((i, j), (1 - fx) * (1 - fy)), ((i + 1, j), fx * (1 - fy)),
+            ((i, j + 1), (1 - fx) * fy), ((i + 1, j + 1), fx * fy)]
 
 
 def cache_dir() -> Path:
@@ -176,6 +202,11 @@ class Move:
     start: dict[str, float]
     name: str
     target: float
+    #: the closed form of the cell's inputs jumps on this move (a cell timed as built, whose
+    #: closed form is a step, switches before it): the scene's boundary is then driven along
+    #: a straight ramp from the move's start pose to its end pose, so that the cell is timed
+    #: on inputs that move over the move time as the grid says, not all at once
+    ramp: bool = False
 
 
 def measure(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
@@ -192,10 +223,10 @@ def measure(cls: type[Cell], lib: Library, type_name: str, n: int, params: dict,
 
 
 def measure_in(design, lib: Library, cid: str, moves: list[Move],
-               progress: OnProgress | None = None) -> CellTable:
+               progress: OnProgress | None = None, shapes: bool = False) -> CellTable:
     """Cell ``cid`` of ``design`` timed over the grid: a scene of that cell alone (its output
     body carrying the grid's load), run through ``moves``, the worst of them kept per grid
-    point."""
+    point; with ``shapes`` also its landing each way (the first move each way)."""
     t0 = time.perf_counter()
     mech = design.mechanism
     c = design.netlist.cells[cid]
@@ -208,12 +239,19 @@ def measure_in(design, lib: Library, cid: str, moves: list[Move],
     names = [*FIGURES, *(directed(f, on) for f in DIRECTED for on in (True, False))]
     values = {f: [[0.0] * len(LOADS) for _ in MOVE_TIMES] for f in names}
     total, done = len(MOVE_TIMES) * len(LOADS), 0
+    taken = {"on": False, "off": False}  # a move switched the output that way
+    landing: dict[str, list[list[list[float] | None]]] = {
+        way: [[None] * len(LOADS) for _ in MOVE_TIMES] for way in ("on", "off")}
     for i, mt in enumerate(MOVE_TIMES):
         for j, load in enumerate(LOADS):
             worst = dict.fromkeys(names, 0.0)
             for mv in moves:
                 got = _one_change(mech, lib, types, cid, mv, mt, load, out_body,
                                   cls.outputs[0])
+                way = "on" if got["on"] else "off"
+                taken[way] = True
+                if landing[way][i][j] is None:
+                    landing[way][i][j] = got["shape"]
                 for f in FIGURES:
                     worst[f] = max(worst[f], got[f])
                 for f in DIRECTED:
@@ -224,9 +262,15 @@ def measure_in(design, lib: Library, cid: str, moves: list[Move],
             done += 1
             if progress is not None:
                 progress(done, total)
+    for way in ("on", "off"):  # a way no move took: the worse of the measured, not 0
+        if not taken[way]:
+            for f in DIRECTED:
+                values[directed(f, way == "on")] = [row[:] for row in values[f]]
+    kept = {way: grid for way, grid in landing.items()
+            if all(x is not None for row in grid for x in row)} if shapes else None
     return CellTable(key, c.cell, c.type, len(c.inputs), dict(c.params), mech.ctx.stroke,
                      MOVE_TIMES, LOADS, values, len(moves), time.perf_counter() - t0,
-                     cls.source_sha256)
+                     cls.source_sha256, shapes=kept or None)
 
 
 def _unprefixed(part_json: dict, cid: str) -> dict:
@@ -244,7 +288,7 @@ def _one_change(mech, lib, types, cid: str, mv: Move, move_time: float, load: fl
     key = f"__cell_{cid}"
     mech.outputs[key] = (cid, out_pin)
     try:
-        r = sc.move(mv.name, mv.target)
+        r = sc.move(mv.name, mv.target, reference=_ramp(sc, mv) if mv.ramp else None)
     finally:
         del mech.outputs[key]
     out, ref, t = r.outputs[key], r.reference[key], r.t
@@ -258,9 +302,31 @@ def _one_change(mech, lib, types, cid: str, mv: Move, move_time: float, load: fl
     u = out * mech.ctx.stroke  # mm
     acc = np.gradient(np.gradient(u, t), t)  # mm / s^2
     force = body.mass * float(np.max(np.abs(acc))) / 1000.0  # kg mm/s^2 -> N
+    cross = crossing(t, out)
+    way = float(end - out[0]) or 1.0
+    shape = (np.interp(cross + np.asarray(SHAPE_T), t, (out - out[0]) / way)
+             if math.isfinite(cross) else np.full(len(SHAPE_T), np.nan))
     return {"lag_s": lag if math.isfinite(lag) else 0.0,
             "settle_extra_s": extra if math.isfinite(extra) else 0.0,
-            "overshoot": over, "force_N": force, "on": bool(ref[-1] > ref[0])}
+            "overshoot": over, "force_N": force, "on": bool(ref[-1] > ref[0]),
+            "shape": [round(float(v), 5) for v in shape]}
+
+
+def _ramp(sc: Scene, mv: Move) -> Poses:
+    """The closed form along ``mv`` with every body carried along a straight ramp from its
+    start pose to its end pose (see :attr:`Move.ramp`), as ``Scene.move`` samples it."""
+    k = np.linspace(0.0, 1.0, MOVE_SAMPLES)
+    vals = {nm: np.full(len(k), v) for nm, v in mv.start.items()}
+    vals[mv.name] = mv.start[mv.name] + (mv.target - mv.start[mv.name]) * k
+    cf = sc._kinematic(vals)
+
+    def line(a: np.ndarray) -> np.ndarray:
+        return a[0] + (a[-1] - a[0]) * k
+
+    return Poses(u={b: line(v) for b, v in cf.u.items()},
+                 theta={b: line(cf.theta[b]) for b in cf.theta},
+                 xy={b: (line(x), line(y)) for b, (x, y) in cf.xy.items()},
+                 state=dict(cf.state))
 
 
 def directed(figure: str, on: bool) -> str:
@@ -380,7 +446,7 @@ class Tables:
             return None
         say = self.progress
         tab = measure_in(design, self.lib, cid, mv,
-                         None if say is None else (lambda d, t: say(cid, d, t)))
+                         None if say is None else (lambda d, t: say(cid, d, t)), shapes=True)
         tab.as_built = True
         self.measured.append(cid)
         self.found["measured"] += 1

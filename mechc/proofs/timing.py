@@ -8,10 +8,12 @@ sample's time is where the minimum-jerk profile puts that input position. On top
 on the switching path adds what its table says the dynamics add at its input speed and the
 mass its output net drives, for the way its output switches: the lag of its mid-stroke
 crossing, and (the last cell) how much later it settles; an AMPLIFIER, timed as the design
-built it, passes its late landing on. A gate whose output body only its own spring moves one
-way (a bar held back by its inputs) and whose net's loads are free is timed as built too, by
-a one-dimensional model of that body (:class:`Follower`): its spring, the guides' friction and
-the mass it moves, as the parts give them.
+built it, passes its late landing on, as the waveform it lands with: the cells after it are
+timed on that, not on their closed form (a step there; :class:`Landing`). A gate whose
+output body only its own spring moves one way (a bar held back by its inputs) and whose net's
+loads are free is timed as built too, by a one-dimensional model of that body
+(:class:`Follower`): its spring, the guides' friction and the mass it moves, as the parts
+give them.
 Path delays are the longest sum through the cells whose output switches (static timing
 analysis over the netlist's DAG).
 
@@ -38,6 +40,7 @@ import numpy as np
 from mechc.cells.characterise import (
     DIRECTED,
     SETTLED,
+    SHAPE_T,
     CellTable,
     Move,
     Tables,
@@ -95,13 +98,13 @@ def cell_tables(design: Design, lib: Library, progress: OnProgress | None,
     def moves_of(cid: str) -> list[Move]:
         nonlocal per
         if per is None:
-            per = _switches(nl, names or [], changes or [])
+            per = _switches(nl, names or [], changes or [], stepped)
         n = len(names or [])
         out = []
-        for cur, vec in per.get(cid, []):
+        for cur, vec, jumps in per.get(cid, []):
             k = n - (cur ^ vec).bit_length()
             out.append(Move({nm: float((cur >> (n - 1 - q)) & 1) for q, nm in enumerate(names)},
-                            names[k], float((vec >> (n - 1 - k)) & 1)))
+                            names[k], float((vec >> (n - 1 - k)) & 1), ramp=jumps))
         return out
 
     def tick(cell: str, done: int, total: int) -> None:
@@ -109,6 +112,8 @@ def cell_tables(design: Design, lib: Library, progress: OnProgress | None,
             progress(done, total, f"measuring the timing of cell {cell!r} (first use)")
 
     tabs = Tables(lib, tick)
+    stepped = frozenset(c.id for c in nl.cells.values()  # a step in the closed form
+                        if per_instance(lib[c.cell]) and not lib[c.cell].stateful)
     out: dict[str, CellTable | None] = {}
     for c in nl.topo_cells():
         if changes and per_instance(lib[c.cell]) and not lib[c.cell].stateful:
@@ -118,26 +123,34 @@ def cell_tables(design: Design, lib: Library, progress: OnProgress | None,
     return out, tabs
 
 
-def _switches(nl: Netlist, names: list[str], changes: list[tuple[int, int]]
-              ) -> dict[str, list[tuple[int, int]]]:
+def _switches(nl: Netlist, names: list[str], changes: list[tuple[int, int]],
+              stepped: frozenset[str] = frozenset()) -> dict[str, list[tuple[int, int, bool]]]:
     """Per cell: the first change of ``changes`` that switches its output on and the first
-    that switches it off."""
+    that switches it off, each with whether a cell of ``stepped`` (timed as built: a step in
+    the closed form) switches in the cell's fan-in on it (then its inputs jump in the closed
+    form, and it is timed on a ramp instead: :attr:`mechc.cells.characterise.Move.ramp`)."""
     n = len(names)
     if not changes or nl.state_nets():
         return {}
     logic = nl.evaluate({nm: np.array([[(v >> (n - 1 - k)) & 1 for v in pair]
                                        for pair in changes], dtype=bool).ravel()
                          for k, nm in enumerate(names)})
-    out: dict[str, list[tuple[int, int]]] = {}
+    flips = {net: np.asarray(v).reshape(-1, 2) for net, v in logic.items()}
+    g = nl.combinational_graph() if stepped else None
+    out: dict[str, list[tuple[int, int, bool]]] = {}
     for c in nl.cells.values():
-        v = logic.get(c.outputs[0])
+        v = flips.get(c.outputs[0])
         if v is None:
             continue
-        v = np.asarray(v).reshape(-1, 2)
+        ups = [flips[nl.cells[u].outputs[0]] for u in
+               (nx.ancestors(g, c.id) & stepped if g is not None and c.id in g else ())
+               if nl.cells[u].outputs[0] in flips]
         for want in (True, False):
             hit = np.flatnonzero((v[:, 0] != v[:, 1]) & (v[:, 1] == want))
             if len(hit):
-                out.setdefault(c.id, []).append(changes[int(hit[0])])
+                i = int(hit[0])
+                out.setdefault(c.id, []).append(
+                    (*changes[i], any(bool(u[i, 0] != u[i, 1]) for u in ups)))
     return out
 
 
@@ -174,7 +187,7 @@ def prove_timing(design: Design, spec: Spec, lib: Library,
         # an internal net still moving after the budget keeps the scene from settling even
         # when every output is in time (the dynamic proof's settle asks every body still)
         nets = ch.pop("nets_settle_s", ch["settle_s"])
-        for key in ("switched", "closed_form_end", "closed_form_swing"):
+        for key in ("switched", "nets_lag_s", "closed_form_end", "closed_form_swing"):
             ch.pop(key, None)
         if ch["slack_s"] < 0 or nets > budget:
             late += 1
@@ -230,7 +243,8 @@ def predict_changes(design: Design, lib: Library, names: list[str],
     """Per change (from input vector, to input vector; one input differs): its switching
     outputs' predicted ``switch_s``, ``settle_s`` and the path of cells that sets them. With
     ``detail`` (what the screened proof reads, :mod:`mechc.proofs.screen`) also: ``switched``,
-    the cells whose output switches and in which direction; ``nets_settle_s``, the latest
+    the cells whose output switches and in which direction; ``nets_lag_s``, each switching
+    net's predicted mid-stroke crossing after its closed form's; ``nets_settle_s``, the latest
     predicted settle of any switching net, internal ones included, each from where its own
     closed form settles, as an output's (taking the move's end instead put an amplifier's
     input, switching mid-move, 20-40 % late on the 2-bit adder); ``closed_form_end`` and
@@ -246,6 +260,8 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                    "as_built": tab.as_built} if tab is not None else None)
             for cid, tab in tables.items()}
     follow = followers(design, lib)
+    landing = Landing(tables, {c.id: loads.get(c.outputs[0], 0.0) for c in nl.cells.values()},
+                      follow, st.move_time)
     out_cells = [c.id for c in nl.cells.values() if c.id in mech.cells
                  and lib[types[c.id]].outputs[0] in mech.cells[c.id].terminals] if detail else []
     hold = st.move_time + st.settle_time
@@ -284,18 +300,20 @@ def predict_changes(design: Design, lib: Library, names: list[str],
                 if f is None or c.outputs[0] not in switched:
                     continue
                 on = bool(logic[c.outputs[0]][2 * i + 1])
-                here[c.id] = {**f, **{k: f.get(directed(k, on), f[k]) for k in DIRECTED}}
+                here[c.id] = {**f, **{k: f.get(directed(k, on), f[k]) for k in DIRECTED},
+                              "on": on}
                 fo = follow.get(c.id)
                 got = (_follow(fo, ts, fsig[c.id][i * SAMPLES:(i + 1) * SAMPLES], hold)
                        if fo is not None else None)
                 if got is not None:
                     here[c.id]["follower"] = got
-            arrive, settle, path = _paths(nl, "in:" + moving, switched, here)
+            arrive, settle, path = _paths(nl, "in:" + moving, switched, here, landing)
             rec = {"inputs": _vec(vec, names), "moving": moving,
                    "to": int((vec >> (n - 1 - k)) & 1), "outputs": {}, "settle_s": 0.0}
             if detail:
                 rec["switched"] = {c.id: bool(logic[c.outputs[0]][2 * i + 1])
                                    for c in nl.cells.values() if c.outputs[0] in switched}
+                rec["nets_lag_s"] = {net: v for net, v in arrive.items() if net in switched}
                 rec["nets_settle_s"] = max(
                     (_net_settle(fsig.get(driver[net].id) if net in driver else None, i, ts,
                                  st.move_time) + v
@@ -367,18 +385,23 @@ def _follow(fo: Follower, ts: np.ndarray, cf: np.ndarray, until: float
     return cross - cf_cross, settled_at(t, x, end=float(cf[-1]), within=SETTLED) - cf_settle
 
 
-def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | None]
+def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | None],
+           landing: Landing | None = None
            ) -> tuple[dict[str, float], dict[str, float], dict[str, list[str]]]:
     """Per switched net: the longest sum of the switching cells' lags from ``source`` (the
     arrival of its mid-stroke crossing beyond the closed form's), the settle delay (the
     upstream lags plus the driving cell's own settle extra, or the late landing of a cell timed
     as built upstream passed on; passing every gate's alone-table settle on predicted 26 % and
     82 % late on the random circuits, see docs/performance.md) and the cells on the longest
-    path. A cell's figures carry its direction's lag and settle extra, and ``follower``, its
-    :class:`Follower` model's (used when no late landing reaches its inputs)."""
+    path. A cell's figures carry its direction's lag and settle extra, ``on`` (the way it
+    switches) and ``follower``, its :class:`Follower` model's (used when no late landing
+    reaches its inputs). Behind a late landing, with ``landing``, each net also carries the
+    waveform it lands with (:class:`Landing`): a follower is then run on it, a cell timed as
+    built is read at the input speed it gives, and both settle when their own landing does."""
     arrive: dict[str, float] = {source[3:]: 0.0}
     settle: dict[str, float] = {}
     carried: dict[str, float] = {}
+    wave: dict[str, np.ndarray] = {}
     path: dict[str, list[str]] = {source[3:]: []}
     for c in nl.topo_cells():
         net = c.outputs[0]
@@ -397,12 +420,87 @@ def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | 
             lag, extra = f["follower"]
             f = {**f, "lag_s": max(f["lag_s"], lag),
                  "settle_extra_s": max(f["settle_extra_s"], extra)}
-        arrive[net] = a + f["lag_s"]
-        settle[net] = max(a + f["settle_extra_s"], late + f["lag_s"])
+        got = None
+        if landing is not None:
+            w_in = max(((arrive[x], x) for x in c.inputs if x in wave), default=None)
+            got = landing.through(c.id, f, wave[w_in[1]] if w_in else None)
+        if got is not None:
+            lag, w_out = got
+            arrive[net] = a + lag
+            # never before what the tables alone say (the landing only adds what they miss)
+            settle[net] = max(arrive[net] + landing.settles(w_out), late + lag,
+                              a + f["settle_extra_s"])
+            wave[net] = w_out
+        else:
+            arrive[net] = a + f["lag_s"]
+            settle[net] = max(a + f["settle_extra_s"], late + f["lag_s"])
         if f.get("as_built") or late > 0.0:
             carried[net] = settle[net]
         path[net] = [*path[via], c.id]
     return arrive, settle, path
+
+
+#: Share of a minimum-jerk move spent between 10 % and 90 % of its way.
+_MJ_10_90 = float(np.interp(0.9, min_jerk(np.linspace(0, 1, 4001)), np.linspace(0, 1, 4001))
+                  - np.interp(0.1, min_jerk(np.linspace(0, 1, 4001)), np.linspace(0, 1, 4001)))
+
+
+@dataclass
+class Landing:
+    """What carries a late landing on, cell by cell (:func:`_paths`): the waveform a net
+    lands with, as its share of the way at each of ``SHAPE_T`` from its crossing. It starts
+    at a cell timed as built (its table's ``shapes``), passes unchanged through a gate its
+    input pushes, and through a :class:`Follower` as the follower's own run against it (a
+    bar its spring moves lags a landing as it lags a closed form: adder4's carry AND gates
+    19 ms behind their amplifier, 0.2 ms by their alone table). A cell timed as built behind
+    a landing is read at the move time whose minimum-jerk move rises from 10 % to 90 % as
+    fast as the landing does (its table was measured on inputs moved so: ``Move.ramp``)."""
+
+    tables: dict[str, CellTable | None]
+    loads: dict[str, float]  # cell -> the mass its output net drives (kg)
+    follow: dict[str, Follower]
+    move_time: float
+
+    def through(self, cid: str, f: dict, w_in: np.ndarray | None
+                ) -> tuple[float, np.ndarray] | None:
+        """The cell's lag and the waveform it lands with, or None when no landing reaches
+        or starts at it (the closed form drives it)."""
+        tab = self.tables.get(cid)
+        on = bool(f.get("on", True))
+        if tab is not None and tab.as_built and tab.shapes:
+            mt = self.move_time if w_in is None else self.move_time_of(w_in)
+            v = tab.at(mt, self.loads.get(cid, 0.0))
+            shape = tab.shape(on, mt, self.loads.get(cid, 0.0))
+            if shape is not None and np.isfinite(shape).all():
+                return v.get(directed("lag_s", on), v["lag_s"]), shape
+            return None
+        if w_in is None:
+            return None
+        fo = self.follow.get(cid)
+        start, end = (0.0, 1.0) if on else (1.0, 0.0)
+        if fo is None or fo.force(0.5)[0] * (end - start) <= 0.0:
+            return f["lag_s"], w_in  # pushed by its input: the landing passes on
+        t = np.asarray(SHAPE_T) - SHAPE_T[0]
+        bound = start + (end - start) * np.clip(w_in, 0.0, 1.0)
+        tt, x = fo.run(t, bound, float(t[-1]) + 0.1)
+        cross = crossing(tt, x)
+        if not math.isfinite(cross):
+            return None
+        lag = cross - crossing(t, bound)
+        w_out = np.interp(cross + np.asarray(SHAPE_T), tt, (x - start) / (end - start))
+        return max(f["lag_s"], lag), w_out
+
+    @staticmethod
+    def move_time_of(w: np.ndarray) -> float:
+        """The minimum-jerk move time whose 10-90 % rise takes as long as ``w``'s."""
+        t = np.asarray(SHAPE_T)
+        return max(1e-3, (crossing(t, w, 0.9) - crossing(t, w, 0.1)) / _MJ_10_90)
+
+    @staticmethod
+    def settles(w: np.ndarray) -> float:
+        """From its crossing, when ``w`` stays within ``SETTLED`` of its end (at the latest
+        the last of ``SHAPE_T``)."""
+        return settled_at(np.asarray(SHAPE_T), w, end=1.0, within=SETTLED)
 
 
 def _vec(row: int, names: list[str]) -> dict[str, int]:
