@@ -31,13 +31,12 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import networkx as nx
-
 from mechc.cells.library import Library
 from mechc.errors import MechcError
 from mechc.ir.check import Check
 from mechc.ir.design import Design
 from mechc.ir.netlist import Netlist
+from mechc.ir.paths import essential_hazard_times, set_reset_skew
 from mechc.ir.seqspec import (
     SeqSpec,
     bits_text,
@@ -137,64 +136,21 @@ def _delays(nl: Netlist, lib: Library) -> dict[str, float]:
             for c in nl.cells.values()}
 
 
-def _sr_pins(nl: Netlist) -> dict[str, set[str]]:
-    """MEMORY cell -> the nodes driving its SET and RESET pins."""
-    out: dict[str, set[str]] = {}
-    for u, v, _d in nl.graph.edges(data=True):
-        if v in nl.cells and nl.cells[v].type == "MEMORY":
-            out.setdefault(v, set()).add(u)
-    return out
-
-
-def _path_delays(g: nx.MultiDiGraph, delay: dict[str, float], source: str,
-                 longest: bool, nexts: list[str] | None = None) -> dict[str, float]:
-    """Delay from ``source`` (its own delay excluded) to the output of every node it reaches
-    in the acyclic combinational graph: the longest or the shortest sum of switching delays.
-    ``nexts``: the nodes ``source`` drives, when its edges are not in ``g`` (a MEMORY)."""
-    starts = list(g.successors(source)) if nexts is None else nexts
-    best: dict[str, float] = {source: 0.0}
-    pick = max if longest else min
-    reach = set(starts)
-    for v in starts:
-        reach |= nx.descendants(g, v)
-    for node in nx.topological_sort(g.subgraph(reach)):
-        came = [best[u] for u in g.predecessors(node) if u in best]
-        if node in starts:
-            came.append(0.0)
-        if came:
-            best[node] = pick(came) + delay.get(node, 0.0)
-    return best
-
-
 def timing_inequality(nl: Netlist, lib: Library, req: Requirement,
                       move_time: float) -> dict:
-    """The requirement's inequality with its numbers (see the module docstring); for SET
-    and RESET moving together, the skew between the input's paths to the two pins."""
-    g = nl.combinational_graph()
+    """The requirement's inequality with its numbers (see the module docstring), at the
+    cells' stated delays; for SET and RESET moving together, the skew between the input's
+    paths to the two pins (:mod:`mechc.ir.paths` computes both sides)."""
     delay = _delays(nl, lib)
-    sr = _sr_pins(nl)
-    mem_of = {c.outputs[0]: c.id for c in nl.cells.values() if c.type == "MEMORY"}
     if req.kind == "set-reset-together":
-        return _skew(nl, g, delay, req, mem_of)
-    far = _path_delays(g, delay, "in:" + req.input, longest=True)
-    near = _path_delays(g, delay, "in:" + req.input, longest=False)
-    to_gen = [far[u] for drivers in sr.values() for u in drivers if u in far]
-    t_in = move_time + max(to_gen, default=0.0)
-    t_mem = math.inf
-    for net in req.memories:
-        cid = mem_of.get(net)
-        if cid is None:
-            continue
-        reach = [near[u] for u in sr.get(cid, ()) if u in near]
-        start = move_time / 2 + min(reach, default=0.0)
-        back = _path_delays(g, delay, cid, longest=False,
-                            nexts=sorted(set(nl.graph.successors(cid))))
-        fb = [back[u] for drivers in sr.values() for u in drivers
-              if u in back and u != cid]
-        fb_min = min(fb, default=0.0)
-        t_mem = min(t_mem, start + MEMORY_THROW_S + fb_min)
-    if not math.isfinite(t_mem):
-        t_mem = move_time / 2 + MEMORY_THROW_S
+        skew = set_reset_skew(nl, delay, req.input, req.memories)
+        ok = skew <= MARGIN_S
+        return {"skew_s": round(skew, 4), "margin_s": MARGIN_S, "met": ok,
+                "feedback_delay_needed_s": 0.0,
+                "text": f"skew of {req.input}'s paths to SET and RESET {skew:.3f} s "
+                        f"{'<=' if ok else '>'} margin {MARGIN_S:.3f} s"}
+    t_in, t_mem = essential_hazard_times(nl, delay, req.input, req.memories, move_time,
+                                         MEMORY_THROW_S)
     slack = t_mem - t_in
     need = max(0.0, MARGIN_S - slack)
     return {"t_input_s": round(t_in, 4), "t_memory_feedback_s": round(t_mem, 4),
@@ -202,29 +158,6 @@ def timing_inequality(nl: Netlist, lib: Library, req: Requirement,
             "feedback_delay_needed_s": round(need, 4),
             "text": f"t_memory {t_mem:.3f} s - t_input {t_in:.3f} s = {slack:+.3f} s "
                     f"{'>=' if slack >= MARGIN_S else '<'} margin {MARGIN_S:.3f} s"}
-
-
-def _skew(nl: Netlist, g, delay: dict[str, float], req: Requirement,
-          mem_of: dict[str, str]) -> dict:
-    """SET and RESET of a memory driven by one moving input: the one going off must release
-    before the other comes on, so the input's delays to the two pins may differ by at most
-    the margin (001 Appendix B.2)."""
-    far = _path_delays(g, delay, "in:" + req.input, longest=True)
-    near = _path_delays(g, delay, "in:" + req.input, longest=False)
-    skew = 0.0
-    for net in req.memories:
-        cid = mem_of.get(net)
-        if cid is None:
-            continue
-        drivers = [u for u, v in g.in_edges(cid) if u in far]
-        if len(drivers) == 2:
-            a, b = drivers
-            skew = max(skew, far[a] - near[b], far[b] - near[a])
-    ok = skew <= MARGIN_S
-    return {"skew_s": round(skew, 4), "margin_s": MARGIN_S, "met": ok,
-            "feedback_delay_needed_s": 0.0,
-            "text": f"skew of {req.input}'s paths to SET and RESET {skew:.3f} s "
-                    f"{'<=' if ok else '>'} margin {MARGIN_S:.3f} s"}
 
 
 def tour_of(spec: SeqSpec, wanted: set[tuple[int, object, int]]) -> list[list[dict[str, int]]]:

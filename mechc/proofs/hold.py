@@ -24,11 +24,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import networkx as nx
-
 from mechc.cells.characterise import Tables
 from mechc.cells.library import Library
 from mechc.ir.design import Design
+from mechc.ir.paths import latest
 from mechc.parts.pushrod import net_loads
 
 #: The hold is this many times the static critical path (when that is above the default):
@@ -87,7 +86,7 @@ def static_path(design: Design, lib: Library, move_time: float,
         v = tab.at(move_time, loads.get(c.outputs[0], 0.0)) if tab is not None else {}
         lag[c.id] = max([stated] + [v[k] for k in _LAGS if k in v])
         extra[c.id] = max([0.0] + [v[k] for k in _EXTRAS if k in v])
-    arrive, came = _latest(nl.combinational_graph(), lag)
+    arrive, came = latest(nl.combinational_graph(), lag)
     end = max(nl.cells, key=lambda c: (arrive[c] + extra[c], c))
     cells = []
     node: str | None = end
@@ -98,19 +97,6 @@ def static_path(design: Design, lib: Library, move_time: float,
     return StaticPath(arrive[end] + extra[end], tuple(reversed(cells)), tuple(untabled))
 
 
-def _latest(g: nx.MultiDiGraph, delay: dict[str, float]
-            ) -> tuple[dict[str, float], dict[str, str | None]]:
-    """Every node's latest arrival in the acyclic graph ``g`` (the slowest chain of
-    ``delay`` from a source, its own delay included) and the node that chain came through."""
-    arrive: dict[str, float] = {}
-    came: dict[str, str | None] = {}
-    for node in nx.topological_sort(g):
-        before = max(g.predecessors(node), key=lambda u: arrive[u], default=None)
-        arrive[node] = (arrive[before] if before is not None else 0.0) + delay.get(node, 0.0)
-        came[node] = before
-    return arrive, came
-
-
 def settle_allowance(design: Design, lib: Library) -> float:
     """How long after an input's move a sequential circuit may still be switching: along the
     slowest path, each cell's stated switching delay (an AMPLIFIER's measured one), and a
@@ -119,7 +105,7 @@ def settle_allowance(design: Design, lib: Library) -> float:
     nl = design.netlist
     delay = {c.id: float(getattr(lib[c.cell], "switching_delay_s", 0.0))
              for c in nl.cells.values()}
-    arrive, _came = _latest(nl.combinational_graph(), delay)
+    arrive, _came = latest(nl.combinational_graph(), delay)
     path = max(arrive.values(), default=0.0)
     m = sum(1 for c in nl.cells.values() if getattr(lib[c.cell], "stateful", False))
     return 0.1 + (m + 1) * (path + MEMORY_THROW_S)

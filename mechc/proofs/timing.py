@@ -53,6 +53,7 @@ from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.ir.mechanism import GROUND
 from mechc.ir.netlist import Netlist
+from mechc.ir.paths import essential_hazard_times, set_reset_skew
 from mechc.ir.seqspec import SeqSpec
 from mechc.ir.spec import Spec
 from mechc.parts.pushrod import net_loads, net_rods
@@ -556,66 +557,24 @@ def seq_timing_engine(design: Design, spec: SeqSpec, lib: Library, settings: Pro
 
 
 def inequality(nl: Netlist, delay: dict[str, float], req: dict, move_time: float) -> dict:
-    """One requirement as an inequality with its slack: for an essential hazard, the moving
-    input must reach every SET/RESET generator (longest path) before a switching memory's
-    new state does and comes back (shortest path, the memory's throw); for SET and RESET
-    moving together, the skew between the input's paths to the two pins must stay within
-    the margin."""
-    g = nl.combinational_graph()
-    sr: dict[str, set[str]] = {}
-    for u, v in nl.graph.edges():
-        if v in nl.cells and nl.cells[v].type == "MEMORY":
-            sr.setdefault(v, set()).add(u)
-    mem_of = {c.outputs[0]: c.id for c in nl.cells.values() if c.type == "MEMORY"}
-    src = "in:" + req["input"]
-    far = _sum_paths(g, delay, [*g.successors(src)], max)
-    near = _sum_paths(g, delay, [*g.successors(src)], min)
+    """One requirement as an inequality with its slack, at ``delay`` (compile's own, at the
+    stated delays: :func:`mechc.passes.ordering.timing_inequality`; both sides from
+    :mod:`mechc.ir.paths`): for an essential hazard, the moving input must reach every
+    SET/RESET generator (longest path) before a switching memory's new state does and comes
+    back (shortest path, the memory's throw); for SET and RESET moving together, the skew
+    between the input's paths to the two pins must stay within the margin."""
     if req["kind"] == "set-reset-together":
-        skew = 0.0
-        for net in req["memories"]:
-            drivers = [u for u in sr.get(mem_of.get(net, ""), ()) if u in far]
-            if len(drivers) == 2:
-                a, b = drivers
-                skew = max(skew, far[a] - near[b], far[b] - near[a])
+        skew = set_reset_skew(nl, delay, req["input"], req["memories"])
         slack = MARGIN_S - skew
         return {"skew_s": round(skew, 5), "slack_s": round(slack, 5), "met": slack >= 0,
                 "text": f"skew {skew:.4f} s <= margin {MARGIN_S:.3f} s (slack {slack:+.4f} s)"}
-    t_in = move_time + max((far[u] for d in sr.values() for u in d if u in far), default=0.0)
-    t_mem = math.inf
-    for net in req["memories"]:
-        cid = mem_of.get(net)
-        if cid is None:
-            continue
-        start = move_time / 2 + min((near[u] for u in sr.get(cid, ()) if u in near),
-                                    default=0.0)
-        back = _sum_paths(g, delay, sorted(set(nl.graph.successors(cid))), min)
-        fb = min((back[u] for d in sr.values() for u in d if u in back and u != cid),
-                 default=0.0)
-        t_mem = min(t_mem, start + MEMORY_THROW_S + fb)
-    if not math.isfinite(t_mem):
-        t_mem = move_time / 2 + MEMORY_THROW_S
+    t_in, t_mem = essential_hazard_times(nl, delay, req["input"], req["memories"], move_time,
+                                         MEMORY_THROW_S)
     slack = t_mem - t_in - MARGIN_S
     return {"t_input_s": round(t_in, 5), "t_memory_feedback_s": round(t_mem, 5),
             "slack_s": round(slack, 5), "met": slack >= 0,
             "text": f"t_memory {t_mem:.4f} s - t_input {t_in:.4f} s >= margin {MARGIN_S:.3f} s "
                     f"(slack {slack:+.4f} s)"}
-
-
-def _sum_paths(g: nx.MultiDiGraph, delay: dict[str, float], starts: list[str], pick
-               ) -> dict[str, float]:
-    """Longest (``pick=max``) or shortest (``min``) sum of cell delays from the nodes
-    ``starts`` (their own delay included) to every node they reach in the acyclic graph."""
-    reach = set(starts)
-    for v in starts:
-        reach |= nx.descendants(g, v)
-    best: dict[str, float] = {}
-    for node in nx.topological_sort(g.subgraph(reach)):
-        came = [best[u] for u in g.predecessors(node) if u in best]
-        if node in starts:
-            came.append(0.0)
-        if came:
-            best[node] = pick(came) + delay.get(node, 0.0)
-    return best
 
 
 # ---- a spring-driven output: how fast its own spring can move what its net carries --------
