@@ -62,8 +62,17 @@ def set_reset_drivers(nl: Netlist) -> dict[str, set[str]]:
     return out
 
 
-def _memory_of(nl: Netlist) -> dict[str, str]:
-    return {c.outputs[0]: c.id for c in nl.cells.values() if c.type == "MEMORY"}
+def _from_input(nl: Netlist, delay: dict[str, float], moving: str
+                ) -> tuple[nx.MultiDiGraph, dict[str, set[str]], dict[str, str],
+                           dict[str, float], dict[str, float]]:
+    """The combinational graph, each memory's SET/RESET drivers, memory net -> cell, and the
+    longest and shortest sums from input ``moving`` to every node it reaches."""
+    g = nl.combinational_graph()
+    src = list(g.successors("in:" + moving))
+    far, _ = path_sums(g, delay, src, max)
+    near, _ = path_sums(g, delay, src, min)
+    mem_of = {c.outputs[0]: c.id for c in nl.cells.values() if c.type == "MEMORY"}
+    return g, set_reset_drivers(nl), mem_of, far, near
 
 
 def essential_hazard_times(nl: Netlist, delay: dict[str, float], moving: str,
@@ -73,12 +82,7 @@ def essential_hazard_times(nl: Netlist, delay: dict[str, float], moving: str,
     has reached every SET/RESET generator by its longest path, and the earliest that one of
     the ``memories`` (their nets) can have switched (mid-move by the input's shortest path to
     its pins, then ``throw``) and come back to a generator by the shortest path."""
-    g = nl.combinational_graph()
-    sr = set_reset_drivers(nl)
-    mem_of = _memory_of(nl)
-    src = list(g.successors("in:" + moving))
-    far, _ = path_sums(g, delay, src, max)
-    near, _ = path_sums(g, delay, src, min)
+    g, sr, mem_of, far, near = _from_input(nl, delay, moving)
     t_in = move_time + max((far[u] for d in sr.values() for u in d if u in far), default=0.0)
     t_mem = math.inf
     for net in memories:
@@ -100,12 +104,7 @@ def set_reset_skew(nl: Netlist, delay: dict[str, float], moving: str,
                    memories: Iterable[str]) -> float:
     """The largest difference between input ``moving``'s longest path to one of a memory's
     two pins and its shortest to the other, over the ``memories`` (their nets)."""
-    g = nl.combinational_graph()
-    sr = set_reset_drivers(nl)
-    mem_of = _memory_of(nl)
-    src = list(g.successors("in:" + moving))
-    far, _ = path_sums(g, delay, src, max)
-    near, _ = path_sums(g, delay, src, min)
+    _g, sr, mem_of, far, near = _from_input(nl, delay, moving)
     skew = 0.0
     for net in memories:
         drivers = [u for u in sorted(sr.get(mem_of.get(net, ""), ())) if u in far]
