@@ -1,7 +1,8 @@
 """Where the timing level's prediction of one change goes wrong, cell by cell: every switching
 cell's mid-stroke crossing in the whole scene against the timing level's.
 
-    python benchmarks/chain.py [SPEC_OR_DESIGN] [--levels multi] [--change K] [--out DIR]
+    python benchmarks/chain.py [SPEC_OR_DESIGN] [--levels multi] [--change K]
+                               [--iterations N] [--out DIR]
 
 Default: ``examples/multilevel/adder4.v`` built multi-level, the change the timing level
 predicts to settle latest. The change runs once in pymunk from rest in its start state (as
@@ -58,12 +59,14 @@ def main() -> None:
                     help="how a spec is built (compile's --levels; default multi)")
     ap.add_argument("--change", type=int, help="the plan's change K (default: the latest "
                     "predicted settle)")
+    ap.add_argument("--iterations", type=int, metavar="N",
+                    help="solver iterations of the scene (default: the dynamic proof's)")
     ap.add_argument("--out", help="directory for chain.csv and chain.png")
     args = ap.parse_args()
     out = Path(args.out or tempfile.mkdtemp(prefix="mechc-chain-"))
     out.mkdir(parents=True, exist_ok=True)
     d = load(args.design, args.levels)
-    ch = compare(d, LIB, args.change)
+    ch = compare(d, LIB, args.change, args.iterations)
     rows = {v["cell"]: v for v in ch.rows}
     order = [v["cell"] for v in ch.rows]
     print(f"{args.design}: {len(d.netlist.cells)} cells, change {ch.change} of {ch.changes} "

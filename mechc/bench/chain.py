@@ -45,13 +45,15 @@ class Chain:
     t: object  # the scene's sample times
 
 
-def compare(d: Design, lib: Library, change: int | None = None) -> Chain:
+def compare(d: Design, lib: Library, change: int | None = None,
+            iterations: int | None = None) -> Chain:
     """The ``change``-th change of the dynamic proof's plan (default: the one the timing
-    level predicts to settle latest), run and predicted."""
+    level predicts to settle latest), run (at ``iterations`` of the solver: default the
+    proof's) and predicted."""
     nl, mech = d.netlist, d.mechanism
     names = list(d.spec.inputs)
     n = len(names)
-    st = dyn_settings(d, lib)
+    st = dyn_settings(d, lib, iterations=iterations)
     pairs, _ = plan_changes(d, names, 16, 0, independent=blocker(nl, lib) is None)
     tables, _ = cell_tables(d, lib, None, names, pairs)
     timed = predict_changes(d, lib, names, pairs, st, tables, detail=True)
