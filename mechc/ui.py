@@ -6,7 +6,7 @@ import argparse
 import math
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 
 class Progress:
@@ -61,6 +61,16 @@ class Progress:
         if total != self.total:
             self.total = total
             self.last_decile = -1
+
+    def counter(self, unit: str) -> Callable[..., None]:
+        """The callback a job reports to as ``(done, total)`` in ``unit``, or ``(done, total,
+        what)`` for other work on the way (a proof's progress, ``mechc.proofs.registry``)."""
+
+        def tick(done: int, total: int, what: str = "") -> None:
+            self.retotal(total)
+            self.update(done, what or unit)
+
+        return tick
 
     def close(self) -> None:
         if self.shown and self.tty:

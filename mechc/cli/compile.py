@@ -223,14 +223,9 @@ def prove_written(obj: dict, out: str, args: argparse.Namespace, stages: StagePr
                         f"{out} --level kinematic)"})
         return results
     bar = Progress(1, "compile: kinematic proof", enabled=not args.quiet)
-
-    def tick(done: int, total: int, what: str = "") -> None:
-        bar.retotal(total)
-        bar.update(done, what or "states")
-
     stages.start("prove kinematic")
     try:
-        rep = prove(design, spec, lib, "kinematic", ProofSettings(), tick)
+        rep = prove(design, spec, lib, "kinematic", ProofSettings(), bar.counter("states"))
     finally:
         bar.close()
     stages.end("prove kinematic", rep.seconds)

@@ -213,10 +213,8 @@ def _prove(args: argparse.Namespace, design: Design, spec: Spec | SeqSpec, lib: 
              if args.level in DYNAMIC and settings.jobs > 1 and not trace else "")
     bar = Progress(1, f"{what} proof of {Path(args.design).name}{where}")
 
-    def tick(done: int, total: int, what: str = "") -> None:
-        bar.retotal(total)
-        bar.update(done, what or {"dynamic": "input changes", "screened": "input changes",
-                                  "timing": "cell measurements"}.get(args.level, "states"))
+    tick = bar.counter({"dynamic": "input changes", "screened": "input changes",
+                        "timing": "cell measurements"}.get(args.level, "states"))
 
     try:
         return prove(design, spec, lib, args.level, settings, tick)

@@ -93,9 +93,7 @@ def run(args: argparse.Namespace) -> int:
 
         bar = Progress(1, f"GIF of {Path(args.design).name}")
 
-        def drawn(done: int, total: int) -> None:
-            bar.retotal(total)
-            bar.update(done, "frames")
+        drawn = bar.counter("frames")
 
         try:
             frames, size = gif.write(anim, args.gif, width=args.gif_width, fps=args.fps,
@@ -129,11 +127,8 @@ def build_animation(args: argparse.Namespace, design: Design) -> tuple[animation
                         else "dynamic")
                 bar = Progress(1, f"{what} proof of {Path(args.design).name}")
 
-                def tick(done: int, total: int, what: str = "", bar=bar) -> None:
-                    bar.retotal(total)
-                    bar.update(done, what or "input changes")
-
-                report = prove(design, spec, lib, level, settings, tick)
+                report = prove(design, spec, lib, level, settings,
+                               bar.counter("input changes"))
             else:
                 report = prove(design, spec, lib, level, settings)
         except UsageError as e:
