@@ -467,6 +467,15 @@ def per_instance(cls: type[Cell]) -> bool:
     return float(getattr(cls, "switching_delay_s", 0.0) or 0.0) > 0.0
 
 
+def measuring(progress: Callable[..., None] | None) -> Callable[[str, int, int], None] | None:
+    """A proof's ``progress`` (told ``(done, total, what)``) as :class:`Tables` calls it while
+    a cell is measured, the cell named."""
+    if progress is None:
+        return None
+    return lambda cell, done, total: progress(done, total, f"measuring the timing of cell "
+                                                           f"{cell!r} (first use)")
+
+
 def _read_shipped() -> list[dict]:
     if not SHIPPED.exists():
         return []

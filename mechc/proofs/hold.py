@@ -24,17 +24,16 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from mechc.cells.characterise import Tables
+from mechc.cells.characterise import Tables, measuring
 from mechc.cells.library import Library
 from mechc.ir.design import Design
 from mechc.ir.paths import latest
 from mechc.parts.pushrod import net_loads
 
-#: The hold is this many times the static critical path (when that is above the default):
-#: the path's lags are each cell's at the proof's input speed, and a cell driven by a gate
-#: moves its input more slowly than that, so the path is not an upper bound. Measured
-#: (docs/mechanism.md): the latest settle was 0.92 of the path on a 4-bit adder's 11-cell
-#: chain and 1.47 of it on a 16-bit adder's 58-cell one.
+#: The hold is this many times the static critical path (when that is above the default): a
+#: measured allowance, not a bound. The latest settle was 0.92 of the path on a 4-bit adder's
+#: 11-cell chain and 1.47 of it on a 16-bit adder's 58-cell one, whose chain itself settles
+#: within the path: the rest is a tremor of the solver's (docs/mechanism.md).
 HOLD_FACTOR = 2.0
 #: An allowance (s) for a MEMORY's lever to go from upright to its stop (the detent's throw).
 MEMORY_THROW_S = 0.03
@@ -69,9 +68,7 @@ def static_path(design: Design, lib: Library, move_time: float,
     mech = design.mechanism
     if mech is None or not nl.cells:
         return StaticPath(0.0, ())
-    tabs = Tables(lib, None if progress is None else (
-        lambda cell, done, total: progress(done, total, f"measuring the timing of cell "
-                                                        f"{cell!r} (first use)")))
+    tabs = Tables(lib, measuring(progress))
     loads = net_loads(mech)
     lag: dict[str, float] = {}
     extra: dict[str, float] = {}

@@ -46,6 +46,7 @@ from mechc.cells.characterise import (
     Tables,
     crossing,
     directed,
+    measuring,
     per_instance,
     settled_at,
 )
@@ -108,16 +109,12 @@ def cell_tables(design: Design, lib: Library, progress: OnProgress | None,
                             names[k], float((vec >> (n - 1 - k)) & 1), ramp=jumps))
         return out
 
-    def tick(cell: str, done: int, total: int) -> None:
-        if progress is not None:
-            progress(done, total, f"measuring the timing of cell {cell!r} (first use)")
-
-    tabs = Tables(lib, tick)
+    tabs = Tables(lib, measuring(progress))
     stepped = frozenset(c.id for c in nl.cells.values()  # a step in the closed form
                         if per_instance(lib[c.cell]) and not lib[c.cell].stateful)
     out: dict[str, CellTable | None] = {}
     for c in nl.topo_cells():
-        if changes and per_instance(lib[c.cell]) and not lib[c.cell].stateful:
+        if changes and c.id in stepped:
             out[c.id] = tabs.instance(design, c.id, lambda cid=c.id: moves_of(cid))
         else:
             out[c.id] = tabs.get(c.cell, c.type, len(c.inputs), dict(c.params), stroke)
@@ -442,8 +439,7 @@ def _paths(nl: Netlist, source: str, switched: set[str], figs: dict[str, dict | 
 
 
 #: Share of a minimum-jerk move spent between 10 % and 90 % of its way.
-_MJ_10_90 = float(np.interp(0.9, min_jerk(np.linspace(0, 1, 4001)), np.linspace(0, 1, 4001))
-                  - np.interp(0.1, min_jerk(np.linspace(0, 1, 4001)), np.linspace(0, 1, 4001)))
+_MJ_10_90 = float(np.subtract(*sample_times(1.0, 11)[[9, 1]]))
 
 
 @dataclass
