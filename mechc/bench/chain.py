@@ -15,6 +15,8 @@ import dataclasses
 import time
 from dataclasses import dataclass
 
+import numpy as np
+
 from mechc.cells.characterise import crossing, settled_at
 from mechc.cells.library import Library
 from mechc.ir.design import Design
@@ -41,8 +43,8 @@ class Chain:
     predicted_settle_s: float  # the latest switching net's, from the move's start
     scene_settle_s: float  # the dynamic proof's (every body still), from the move's start
     scene_seconds: float
-    outputs: dict  # the scene's record of every switching cell's output (PREFIX + cell id)
-    t: object  # the scene's sample times
+    outputs: dict[str, np.ndarray]  # every switching cell's output in the scene (PREFIX + id)
+    t: np.ndarray  # the scene's sample times
 
 
 def compare(d: Design, lib: Library, change: int | None = None,
