@@ -1,10 +1,12 @@
 """The dynamic proof runs the changes failing on a joint stretch, contact overrun or late settle
-again at twice the iterations, and says which failures went away there (the solver's) and
-which did not (the mechanism's); it never changes the verdict. Real failures of the full
-adder: one iteration per step breaks joints (a few changes pass at two), inputs thrown in
-10 ms do not settle (at 60 iterations nor at 120). The sequential proof runs its failing
-pieces of walks again (each from power-up) and counts the steps: the gated latch at one
-iteration."""
+again at twice the iterations and proves them there: a change that passes every check at the
+finer setting failed by the solver and counts as passed (the report is tallied with its finer
+run); one that still fails is the mechanism's or needs finer settings still, and says so.
+Real failures of the full adder: one iteration per step breaks joints (a few changes pass at
+two), at three iterations every failing change passes at six, inputs thrown in 10 ms do not
+settle (at 60 iterations nor at 120). The sequential proof runs its failing pieces of walks
+again (each from power-up) and proves a piece whose every step passes there: the gated latch
+at one iteration."""
 
 from __future__ import annotations
 
@@ -51,42 +53,74 @@ def _finer_truth(design, iterations: int, **kw) -> dict[tuple, list[str]]:
     return {_key(r): r["failure_kinds"] for r in rec}
 
 
-def _check_finer(r: ProofReport, truth: dict[tuple, list[str]]) -> set[tuple]:
-    """Every failure entry of a rechecked change says what the independent finer run says;
-    the rechecked changes are the first failing ones (solver, contact, settle) in plan order."""
-    rechecked = {_key(f) for f in r.failures if "finer" in f}
+def _check_finer(first: ProofReport, truth: dict[tuple, list[str]],
+                 r: ProofReport | None = None) -> set[tuple]:
+    """The changes re-run are the first failing ones (solver, contact, settle) of ``first``
+    in plan order; every failure entry ``r`` (default ``first``) still lists for a re-run
+    change says what the independent finer run ``truth`` says: it still fails."""
+    r = r or first
+    order: list[tuple] = []
+    for f in first.failures:
+        if f.get("kind") in RECHECKED and _key(f) not in order:
+            order.append(_key(f))
+    rechecked = set(order[:RECHECK_MAX])
     for f in r.failures:
         if "finer" in f:
             want = truth[_key(f)]
-            assert f["finer"]["failure_kinds"] == want, f
-            assert f["finer"]["passed"] == (not want)
-    first: list[tuple] = []
-    for f in r.failures:
-        if f.get("kind") in RECHECKED and _key(f) not in first:
-            first.append(_key(f))
-    assert rechecked == set(first[:RECHECK_MAX])
+            assert _key(f) in rechecked and want, f
+            assert f["finer"]["failure_kinds"] == want and not f["finer"]["passed"]
+        elif "inputs" in f:
+            assert _key(f) not in rechecked or not truth[_key(f)], f
     return rechecked
+
+
+def _without(r: ProofReport, proved: set[tuple]) -> list[dict]:
+    """``r``'s failures but those of the changes in ``proved``, without ``finer``."""
+    return [f for f in _without_finer(r) if "inputs" not in f or _key(f) not in proved]
+
+
+def _expected_figures(coarse: list[dict], fine: list[dict], proved: set[tuple]) -> dict:
+    """The figures of a proof whose ``proved`` changes ran finer (records of the two runs)."""
+    rows = [r for r in coarse if _key(r) not in proved] + [r for r in fine if _key(r) in proved]
+    settles = [r["settle_time_s"] for r in rows if r["settle_time_s"] != float("inf")]
+    return {"max_joint_violation_mm": round(max(r["max_violation_mm"] for r in rows), 6),
+            "max_contact_penetration_mm": round(max(r["max_penetration_mm"] for r in rows), 6),
+            "max_settle_time_s": round(max(settles), 5)}
 
 
 def test_one_iteration_failures_are_told_apart_at_two(adder):
     st = dyn_settings(adder, iterations=1)
     on = prove_dynamic(adder, adder.spec, LIB, st, jobs=2)
-    off = prove_dynamic(adder, adder.spec, LIB, st, jobs=2, recheck=False)
-    assert _verdict(on) == _verdict(off) and not on.passed and "solver" in on.failure_kinds
+    coarse: list[dict] = []
+    off = prove_dynamic(adder, adder.spec, LIB, st, jobs=2, recheck=False, record=coarse)
+    assert not on.passed and not off.passed and "solver" in on.failure_kinds
+    assert off.failure_count == len(off.failures)  # every failure listed: comparable
     assert "recheck" not in off.figures and not any("finer" in f for f in off.failures)
     truth = _finer_truth(adder, 2)
-    rechecked = _check_finer(on, truth)
+    rechecked = _check_finer(off, truth, on)
+    proved = {k for k in rechecked if not truth[k]}
     rc = on.figures["recheck"]
-    solver_s = sum(not truth[k] for k in rechecked)
     assert (rc["iterations"], rc["changes"]) == (2, len(rechecked)) == (2, RECHECK_MAX)
-    assert (rc["passed_finer"], rc["failed_finer"]) == (solver_s, RECHECK_MAX - solver_s)
-    assert 0 < solver_s < RECHECK_MAX  # both kinds of failure, for real
+    assert (rc["passed_finer"], rc["failed_finer"]) == (len(proved), RECHECK_MAX - len(proved))
+    assert 0 < len(proved) < RECHECK_MAX  # both kinds of failure, for real
+    # the changes passing at two count as passed; the rest of the report is the proof's own
+    assert {_key(p) for p in rc["proved_finer"]} == proved
+    assert _without_finer(on) == _without(off, proved)
+    assert on.failure_count == off.failure_count - sum(
+        1 for f in off.failures if "inputs" in f and _key(f) in proved)
+    fine: list[dict] = []
+    prove_dynamic(adder, adder.spec, LIB, dyn_settings(adder, iterations=2), record=fine,
+                  recheck=False, jobs=2)
+    want = _expected_figures(coarse, fine, proved)
+    assert {k: on.figures[k] for k in want} == want
     failing = {_key(f) for f in off.failures if f["kind"] in RECHECKED}
     assert rc["not_rechecked"] == len(failing) - RECHECK_MAX > 0
     text = on.summary_text()
-    assert (f"re-run at 2 iterations: {solver_s} of {RECHECK_MAX} failing changes "
-            f"{'passes' if solver_s == 1 else 'pass'} there (the solver's), "
-            f"{RECHECK_MAX - solver_s} still fail") in text
+    assert (f"re-run at 2 iterations: {len(proved)} of {RECHECK_MAX} failing changes "
+            f"{'passes' if len(proved) == 1 else 'pass'} there (the solver's: proved at 2 "
+            f"iterations, {'it counts' if len(proved) == 1 else 'they count'} as passed), "
+            f"{RECHECK_MAX - len(proved)} still fail") in text
+    assert text.count("  proved at 2 iterations: ") == len(proved)
     # the changes beyond the cap keep the generic hint
     assert f"{rc['not_rechecked']} more such failing changes were not re-run" in text
     assert "run again with --iterations 2 or --dt" in text
@@ -94,11 +128,44 @@ def test_one_iteration_failures_are_told_apart_at_two(adder):
     for f in on.failures:
         line = failure_text(f)
         if "finer" in f:
-            assert line.endswith("; at 2 iterations: "
-                                 + ("passes" if f["finer"]["passed"] else "still fails"))
+            assert line.endswith("; at 2 iterations: still fails")
         else:
             assert "iterations:" not in line
     assert any(failure_text(f) in text for f in on.failures if "finer" in f)
+
+
+def test_a_design_whose_failures_are_all_the_solvers_passes(adder, cli, tmp_path):
+    """At three iterations five changes of the full adder fail; at six each passes, so the
+    proof passes, proved partly at six, and says so; without the re-run it fails."""
+    coarse: list[dict] = []
+    off = prove_dynamic(adder, adder.spec, LIB, dyn_settings(adder, iterations=3), jobs=2,
+                        recheck=False, record=coarse)
+    failing = {_key(r) for r in coarse if r["failure_kinds"]}
+    assert not off.passed and 0 < len(failing) <= RECHECK_MAX
+    assert all(set(r["failure_kinds"]) <= RECHECKED for r in coarse)
+    fine: list[dict] = []
+    prove_dynamic(adder, adder.spec, LIB, dyn_settings(adder, iterations=6), record=fine,
+                  recheck=False, jobs=2)
+    assert not any(r["failure_kinds"] for r in fine if _key(r) in failing)  # independent
+    report = tmp_path / "r.json"
+    code, out, _ = cli("simulate", EXAMPLES / "full_adder.bool", "--level", "dynamic",
+                       "--iterations", "3", "--report", report)
+    r = json.loads(report.read_text())
+    assert code == 0 and r["passed"] and r["failure_count"] == 0 and r["failures"] == []
+    rc = r["recheck"]
+    assert {_key(p) for p in rc["proved_finer"]} == failing
+    assert all(p["iterations"] == 6 and p["passed"] and p["failure_kinds_at_settings"]
+               for p in rc["proved_finer"])
+    assert {k: r[k] for k in ("max_joint_violation_mm", "max_contact_penetration_mm",
+                              "max_settle_time_s")} == _expected_figures(coarse, fine, failing)
+    assert "PASSED: level dynamic" in out
+    assert (f"re-run at 6 iterations: {len(failing)} of {len(failing)} failing changes pass "
+            "there (the solver's: proved at 6 iterations, they count as passed)") in out
+    assert out.count("  proved at 6 iterations: ") == len(failing)
+    assert "(failed on " in out and " at 3)" in out
+    code, out, _ = cli("simulate", EXAMPLES / "full_adder.bool", "--level", "dynamic",
+                       "--iterations", "3", "--no-recheck")
+    assert code == 1 and "FAILED" in out
 
 
 def test_a_settle_failure_of_the_mechanism_still_fails_finer_in_the_screened_proof(adder):
@@ -114,7 +181,8 @@ def test_a_settle_failure_of_the_mechanism_still_fails_finer_in_the_screened_pro
     rechecked = _check_finer(scr, _finer_truth(adder, 120, move_time=0.01))
     rc = scr.figures["recheck"]
     assert rc == {"iterations": 120, "changes": len(rechecked), "passed_finer": 0,
-                  "failed_finer": len(rechecked), "not_rechecked": 0, "cap": RECHECK_MAX}
+                  "failed_finer": len(rechecked), "not_rechecked": 0, "cap": RECHECK_MAX,
+                  "proved_finer": []}
     assert "re-run at 120 iterations: 0 of 3 failing changes pass there, all still fail " \
            "(the mechanism's" in scr.summary_text()
     assert "can be the solver's" not in scr.summary_text()  # every such failure re-ran
@@ -125,14 +193,18 @@ def test_a_settle_failure_of_the_mechanism_still_fails_finer_in_the_screened_pro
 
 def test_the_recheck_line_reads_plainly():
     rc = {"iterations": 120, "changes": 4, "passed_finer": 3, "failed_finer": 1,
-          "not_rechecked": 0, "cap": RECHECK_MAX}
-    assert recheck_text({"recheck": rc}) == [
-        "re-run at 120 iterations: 3 of 4 failing changes pass there (the solver's), 1 still "
-        "fails (the mechanism's, or the solver's at finer settings still)"]
-    one = {**rc, "changes": 1, "passed_finer": 1, "failed_finer": 0}
+          "not_rechecked": 0, "cap": RECHECK_MAX,
+          "proved_finer": [{"inputs": {"a": 1, "b": 0}, "moving": "a", "to": 1,
+                            "failure_kinds_at_settings": ["settle"]}]}
+    assert recheck_text({"recheck": rc, "settings": {"iterations": 60}}) == [
+        "re-run at 120 iterations: 3 of 4 failing changes pass there (the solver's: proved at "
+        "120 iterations, they count as passed), 1 still fails (the mechanism's, or the "
+        "solver's at finer settings still)",
+        "  proved at 120 iterations: a -> 1 (failed on settle at 60) at a=1 b=0"]
+    one = {**rc, "changes": 1, "passed_finer": 1, "failed_finer": 0, "proved_finer": []}
     assert recheck_text({"recheck": one}) == [
-        "re-run at 120 iterations: 1 of 1 failing change passes there (the solver's: use "
-        "--iterations 120)"]
+        "re-run at 120 iterations: 1 of 1 failing change passes there (the solver's: proved "
+        "at 120 iterations, it counts as passed)"]
     assert recheck_text({}) == []
 
 
@@ -190,7 +262,7 @@ def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
     on = prove_sequential_dynamic(design, spec, LIB, st, jobs=2,
                                   progress=lambda d, t: seen.append((d, t)))
     off = prove_sequential_dynamic(design, spec, LIB, st, jobs=2, recheck=False)
-    assert _verdict(on) == _verdict(off) and not on.passed
+    assert not on.passed and not off.passed
     assert "recheck" not in off.figures and not any("finer" in f for f in off.failures)
     failing = {k for k, kinds in _step_kinds(off).items() if RECHECKED & set(kinds)}
     # the first RECHECK_MAX pieces holding such a step are the ones re-run, whole
@@ -199,25 +271,35 @@ def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
     assert len(held) > RECHECK_MAX
     chosen = held[:RECHECK_MAX]
     rechecked = {k for k in failing if any(_in_piece(k, p) for p in chosen)}
-    assert {_step(f) for f in on.failures if "finer" in f} == rechecked
     assert any(k[2] is not None for k in rechecked)  # a prefix step is matched too
-    # each says what an independent proof at two iterations says of that step
+    # an independent proof at two iterations runs the same pieces: a piece with no failing
+    # step there is proved, and every failure of it leaves the report
     truth = _step_kinds(prove_sequential_dynamic(
         design, spec, LIB, dyn_settings(design, LIB, iterations=2), jobs=2, recheck=False))
+    whole = [p for p in chosen if not any(_in_piece(k, p) for k in truth)]
+    assert 0 < len(whole) < len(chosen)  # both kinds of piece, for real
+    proved = {k for k in rechecked if any(_in_piece(k, p) for p in whole)}
+    assert [f for f in _without_finer(on)] == [
+        f for f in _without_finer(off)
+        if "sequence" not in f or not any(_in_piece(_step(f), p) for p in whole)]
+    assert on.failure_count == len(on.failures) < off.failure_count
+    # what is left of a re-run piece says what the independent run says of that step
+    assert {_step(f) for f in on.failures if "finer" in f} == rechecked - proved
     for f in on.failures:
         if "finer" in f:
             want = truth.get(_step(f), [])
             assert f["finer"]["failure_kinds"] == want and f["finer"]["passed"] == (not want)
-            assert f["finer"]["iterations"] == 2
-    ok = sum(not truth.get(k) for k in rechecked)
-    assert 0 < ok < len(rechecked)  # both kinds of failure, for real
-    assert on.figures["recheck"] == {
-        "iterations": 2, "changes": len(rechecked), "passed_finer": ok,
-        "failed_finer": len(rechecked) - ok, "not_rechecked": len(failing - rechecked),
-        "cap": RECHECK_MAX}
+            assert f["finer"]["iterations"] == 2 and f["finer"]["piece_passed"] is False
+    rc = on.figures["recheck"]
+    assert {_step(p) for p in rc.pop("proved_finer")} == proved
+    assert rc == {
+        "iterations": 2, "changes": len(rechecked), "passed_finer": len(proved),
+        "failed_finer": len(rechecked) - len(proved),
+        "not_rechecked": len(failing - rechecked), "cap": RECHECK_MAX}
     text = on.summary_text()
-    assert (f"re-run at 2 iterations: {ok} of {len(rechecked)} failing changes pass there "
-            f"(the solver's), {len(rechecked) - ok} still fail") in text
+    assert (f"re-run at 2 iterations: {len(proved)} of {len(rechecked)} failing changes pass "
+            f"there (the solver's: proved at 2 iterations, they count as passed), "
+            f"{len(rechecked) - len(proved)} still fail") in text
     assert f"{len(failing - rechecked)} more such failing changes were not re-run" in text
     # the progress goes on from the proof's steps to the re-run pieces', never back
     done = [d for d, _ in seen]

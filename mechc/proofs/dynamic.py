@@ -292,13 +292,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     runs = [run for seg in run_cases(run_segment, job, segments, lib, jobs, scheduler, progress,
                                      [len(seg) for seg in segments])
             for run in seg]
-    failures: list[dict] = []
-    counts = dict.fromkeys(CHANGE_KINDS, 0)
-    max_err = max_vio = max_pen = max_settle = 0.0
-    worst_joint = ""
-    max_dev = 0.0
     steps = 0
-    failing: list[tuple[int, int]] = []  # changes a finer solver setting may pass
+    outcomes: list[dict] = []  # each change's failures and measures (recheck_failures)
     for ch, run in zip(changes, runs):
         r = run.result
         if prune:
@@ -308,41 +303,24 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
         steps += r.steps
         case = _case(ch, names)
         found = check_change(r, ch, case["moving"], st, tolerance, mech.ctx.stroke)
-        kinds = sorted({f["kind"] for f in found.failures})
+        outcome = _outcome(ch, case, r, found)
+        outcomes.append(outcome)
         if record is not None:
-            record.append({**case, "final": dict(r.final), "max_violation_mm": r.max_violation,
-                           "max_penetration_mm": r.max_penetration,
-                           "settle_time_s": r.settle_time, "steps": r.steps,
+            record.append({**outcome, "final": dict(r.final), "steps": r.steps,
                            "servo_lag_end_mm": r.servo_lag_end,
                            "held_deviation": {o: float(np.max(np.abs(r.outputs[o] - b)))
                                               for o in spec.outputs if o in r.outputs
                                               and (b := ch.before[o]) != DC
-                                              and b == ch.after[o]},
-                           "failure_kinds": kinds})
-        for f in found.failures:
-            counts[f["kind"]] += 1
-            if len(failures) < MAX_LISTED:
-                failures.append({"kind": f["kind"], **case,
-                                 **{k: v for k, v in f.items() if k != "kind"}})
-        if RECHECKED & set(kinds):
-            failing.append((ch.cur, ch.vec))
-        if r.max_violation > max_vio:
-            max_vio, worst_joint = r.max_violation, r.worst_joint
-        max_pen = max(max_pen, r.max_penetration)
-        if math.isfinite(r.settle_time):
-            max_settle = max(max_settle, r.settle_time)
-        max_err = max(max_err, found.error)
-        max_dev = max(max_dev, found.deviation)
+                                              and b == ch.after[o]}})
     stats = CheckStats(mech)
     sweep(design, lib, samples=5, stats=stats)
     kin_checks = stats.checks() + mech.synthesis_checks()
     mus = [c.value for c in kin_checks if c.name == "transmission angle"]
     bad_checks = [c for c in kin_checks if not c.passed]
-    for c in bad_checks:
-        if len(failures) < MAX_LISTED:
-            failures.append({"kind": "design check", "check": c.name, "where": c.where,
-                             "value": round(c.value, 6), "limit": c.limit,
-                             "message": c.text()})
+    failures, counts, fig = tally(outcomes)
+    checks = [{"kind": "design check", "check": c.name, "where": c.where,
+               "value": round(c.value, 6), "limit": c.limit, "message": c.text()}
+              for c in bad_checks]
     total_fail = sum(counts.values()) + len(bad_checks)
     report = ProofReport(
         level="dynamic", kind="combinational", passed=total_fail == 0, cases=len(vectors),
@@ -352,15 +330,9 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
                   **({"exhaustive": False, "transitions": len(pairs),
                       "transitions_total": n << (n - 1), **(chosen or {})} if n > 10 else {})},
         failure_count=total_fail, failure_kinds={k: v for k, v in counts.items() if v},
-        failures=failures,
+        failures=(failures + checks)[:MAX_LISTED],
         figures={
-            "max_position_error_fraction": round(max_err, 6),
-            "max_deviation_fraction": round(max_dev, 6),
-            "min_margin_fraction": round(0.5 - max_dev, 6),
-            "max_joint_violation_mm": round(max_vio, 6),
-            "worst_joint": worst_joint,
-            "max_contact_penetration_mm": round(max_pen, 6),
-            "max_settle_time_s": round(max_settle, 5),
+            **fig,
             "min_transmission_angle_deg": round(min(mus), 4) if mus else None,
             "steps": steps,
             "scene": (_scene_json(None, sizes) if prune else runs[0].scene if runs
@@ -371,28 +343,76 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
             "settings": st.to_json(),
         },
         seconds=0.0)
-    if recheck and failing and not one_scene and trace is None:
-        recheck_failures(design, spec, lib, st, report, failing, tolerance, prune=prune,
+    if recheck and report.failure_count and not one_scene and trace is None:
+        recheck_failures(design, spec, lib, st, report, outcomes, tolerance, prune=prune,
                          cells=cells, freeze=freeze, jobs=jobs, scheduler=scheduler,
                          progress=progress, done_before=len(changes))
     report.seconds = round(time.perf_counter() - t0, 4)
     return report
 
 
+def _outcome(ch: Change, case: dict, r: MoveResult, found: ChangeCheck) -> dict:
+    """One change as the report is tallied from it (:func:`tally`): its failures and the
+    measures its figures take the worst of."""
+    return {**case, "pair": (ch.cur, ch.vec),
+            "failures": [{"kind": f["kind"], **case,
+                          **{k: v for k, v in f.items() if k != "kind"}}
+                         for f in found.failures],
+            "failure_kinds": sorted({f["kind"] for f in found.failures}),
+            "max_violation_mm": r.max_violation, "worst_joint": r.worst_joint,
+            "max_penetration_mm": r.max_penetration, "settle_time_s": r.settle_time,
+            "error": found.error, "deviation": found.deviation}
+
+
+def tally(outcomes: list[dict]) -> tuple[list[dict], dict[str, int], dict]:
+    """The failures listed (the first ``MAX_LISTED``), the count of each kind and the figures
+    of a run of the changes ``outcomes`` (:func:`_outcome`): one code path for the proof and
+    for the proof after a re-run proved changes finer (:func:`recheck_failures`)."""
+    counts = dict.fromkeys(CHANGE_KINDS, 0)
+    failures: list[dict] = []
+    for o in outcomes:
+        for f in o["failures"]:
+            counts[f["kind"]] += 1
+            if len(failures) < MAX_LISTED:
+                failures.append(f)
+    # a NaN stretch (a diverged run) fails its change but is no figure
+    worst = max((o for o in outcomes if not math.isnan(o["max_violation_mm"])),
+                key=lambda o: o["max_violation_mm"], default=None)
+    dev = max((o["deviation"] for o in outcomes), default=0.0)
+    fig = {"max_position_error_fraction": round(max((o["error"] for o in outcomes),
+                                                    default=0.0), 6),
+           "max_deviation_fraction": round(dev, 6),
+           "min_margin_fraction": round(0.5 - dev, 6),
+           "max_joint_violation_mm": round(worst["max_violation_mm"], 6) if worst else 0.0,
+           "worst_joint": worst["worst_joint"] if worst and worst["max_violation_mm"] > 0
+           else "",
+           "max_contact_penetration_mm": round(max((o["max_penetration_mm"] for o in outcomes),
+                                                   default=0.0), 6),
+           "max_settle_time_s": round(max((o["settle_time_s"] for o in outcomes
+                                           if math.isfinite(o["settle_time_s"])),
+                                          default=0.0), 5)}
+    return failures, counts, fig
+
+
 def recheck_failures(design: Design, spec: Spec, lib: Library, st: DynSettings,
-                     report: ProofReport, failing: list[tuple[int, int]], tolerance: float,
+                     report: ProofReport, outcomes: list[dict], tolerance: float,
                      prune: bool = False, cells: list[str] | None = None,
                      freeze: str | None = None, jobs: int = 1, scheduler: str | None = None,
                      progress: Callable[[int, int], None] | None = None,
                      done_before: int = 0) -> None:
-    """Run the first ``RECHECK_MAX`` distinct ``failing`` changes (from, to vector pairs, in
-    plan order) again at twice ``st``'s iterations, on the same kind of scene, and note in
-    ``report`` what they gave: a joint stretch, contact overrun or late settle that goes away
-    there was the solver's. Each of their failure entries gains ``finer``, the figures gain
-    ``recheck``; the verdict and the failure counts stay the proof's own. ``progress`` goes on
-    from ``done_before`` changes."""
+    """Run the first ``RECHECK_MAX`` distinct changes of ``outcomes`` (every change the proof
+    ran, :func:`_outcome`, in plan order) that failed on a joint stretch, contact overrun or
+    late settle again at twice ``st``'s iterations, on the same kind of scene, and prove them
+    there. A change that passes every check at the finer setting failed by the solver: it
+    counts as passed, ``report``'s failures, counts, figures and verdict are tallied again
+    with its finer run in place of its first one, and ``recheck`` in the figures lists it. A
+    change that still fails keeps its failures, each gaining ``finer`` (what the re-run
+    gave). ``progress`` goes on from ``done_before`` changes."""
+    failing = [o["pair"] for o in outcomes if RECHECKED & set(o["failure_kinds"])]
     distinct = list(dict.fromkeys(failing))
     chosen = distinct[:RECHECK_MAX]
+    if not chosen:
+        return
     names = list(spec.inputs)
     finer = replace(st, iterations=2 * st.iterations)
     types = {c.id: c.cell for c in design.netlist.cells.values()}
@@ -405,28 +425,46 @@ def recheck_failures(design: Design, spec: Spec, lib: Library, st: DynSettings,
 
     runs = [seg[0] for seg in run_cases(run_segment, job, [[c] for c in changes], lib, jobs,
                                         scheduler, tick, [1] * len(changes))]
-    by_case: dict[str, dict] = {}
+    again: dict[tuple[int, int], dict] = {}  # pair -> its finer outcome
     for ch, run in zip(changes, runs):
-        r = run.result
         case = _case(ch, names)
-        found = check_change(r, ch, case["moving"], finer, tolerance,
-                             design.mechanism.ctx.stroke)
-        kinds = sorted({f["kind"] for f in found.failures})
-        by_case[repr(case)] = {
-            "iterations": finer.iterations, "passed": not kinds, "failure_kinds": kinds,
-            "max_violation_mm": round(r.max_violation, 6),
-            "max_penetration_mm": round(r.max_penetration, 6),
-            "settle_time_s": round(r.settle_time, 5) if math.isfinite(r.settle_time) else None}
+        again[(ch.cur, ch.vec)] = _outcome(ch, case, run.result, check_change(
+            run.result, ch, case["moving"], finer, tolerance, design.mechanism.ctx.stroke))
+
+    def summary(o: dict) -> dict:
+        return {"iterations": finer.iterations, "passed": not o["failures"],
+                "failure_kinds": o["failure_kinds"],
+                "max_violation_mm": round(o["max_violation_mm"], 6),
+                "max_penetration_mm": round(o["max_penetration_mm"], 6),
+                "settle_time_s": (round(o["settle_time_s"], 5)
+                                  if math.isfinite(o["settle_time_s"]) else None)}
+
+    proved = {pair for pair, o in again.items() if not o["failures"]}
+    if proved:  # the report as if those changes had run finer from the start
+        merged = [again[o["pair"]] if o["pair"] in proved else o for o in outcomes]
+        failures, counts, fig = tally(merged)
+        checks = [f for f in report.failures if f.get("kind") == "design check"]
+        n_checks = report.failure_count - sum((report.failure_kinds or {}).values())
+        report.failure_count = sum(counts.values()) + n_checks
+        report.failure_kinds = {k: v for k, v in counts.items() if v}
+        report.failures = (failures + checks)[:MAX_LISTED]
+        report.figures.update(fig)
+        report.passed = report.failure_count == 0
+    by_case = {repr({k: o[k] for k in ("inputs", "moving", "to")}): summary(o)
+               for o in again.values()}
     for f in report.failures:
         if "inputs" in f:
             key = repr({k: f.get(k) for k in ("inputs", "moving", "to")})
             if key in by_case:
                 f["finer"] = by_case[key]
-    passed = sum(x["passed"] for x in by_case.values())
+    first = {o["pair"]: o for o in reversed(outcomes)}  # each change's run at st
     report.figures["recheck"] = {
-        "iterations": finer.iterations, "changes": len(chosen), "passed_finer": passed,
-        "failed_finer": len(chosen) - passed, "not_rechecked": len(distinct) - len(chosen),
-        "cap": RECHECK_MAX}
+        "iterations": finer.iterations, "changes": len(chosen), "passed_finer": len(proved),
+        "failed_finer": len(chosen) - len(proved), "not_rechecked": len(distinct) - len(chosen),
+        "cap": RECHECK_MAX,
+        "proved_finer": [{**{k: first[p][k] for k in ("inputs", "moving", "to")},
+                          "failure_kinds_at_settings": first[p]["failure_kinds"],
+                          **summary(again[p])} for p in chosen if p in proved]}
 
 
 def prove_with_accuracy(design: Design, spec: Spec, lib: Library, target: float,

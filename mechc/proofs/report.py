@@ -158,9 +158,10 @@ def solver_hint(r: dict) -> list[str]:
 
 def recheck_text(r: dict) -> list[str]:
     """What the re-run of the failing changes at twice the iterations told apart
-    (``mechc.proofs.dynamic.recheck_failures``): a change that passes there failed by the
-    solver; one that still fails is the mechanism's or needs finer settings still. The
-    changes beyond the re-run's cap keep the generic hint."""
+    (``mechc.proofs.dynamic.recheck_failures``): a change that passes every check there
+    failed by the solver and is proved there (it counts as passed); one that still fails is
+    the mechanism's or needs finer settings still. The changes beyond the re-run's cap keep
+    the generic hint."""
     rc = r.get("recheck")
     if not rc:
         return []
@@ -169,13 +170,19 @@ def recheck_text(r: dict) -> list[str]:
     fails = "fails" if bad == 1 else "fail"
     parts = [f"{ok} of {k} failing change{'' if k == 1 else 's'} "
              f"{'passes' if ok == 1 else 'pass'} there"]
-    if ok:  # the advice to re-run finer only where it fixed every change re-run
-        parts[0] += (" (the solver's)" if bad else f" (the solver's: use --iterations {it})")
+    if ok:
+        parts[0] += (f" (the solver's: proved at {it} iterations, "
+                     f"{'it counts' if ok == 1 else 'they count'} as passed)")
     if bad:
         who = "(the mechanism's, or the solver's at finer settings still)"
         parts.append(f"{bad} still {fails} {who}" if ok
                      else f"{'it' if k == 1 else 'all'} still {fails} {who}")
     lines = [f"re-run at {it} iterations: " + ", ".join(parts)]
+    base = (r.get("settings") or {}).get("iterations", it // 2)
+    lines += ["  " + failure_text({
+        "kind": f"proved at {it} iterations", "inputs": p["inputs"], "moving": p["moving"],
+        "to": p["to"], "message": f"(failed on {', '.join(p['failure_kinds_at_settings'])} at "
+                                  f"{base})"}) for p in rc.get("proved_finer", [])[:SHOWN_FAILURES]]
     if rc.get("not_rechecked"):
         lines.append(f"{rc['not_rechecked']} more such failing changes were not re-run (at "
                      f"most {rc['cap']} are): " + " ".join(solver_hint(r)))
@@ -290,7 +297,9 @@ def failure_text(f: dict) -> str:
     finer = f.get("finer")
     if finer:  # what the re-run at finer settings gave (mechc.proofs.dynamic.recheck_failures)
         line += (f"; at {finer['iterations']} iterations: "
-                 + ("passes" if finer["passed"] else "still fails"))
+                 + ("still fails" if not finer["passed"] else
+                    "passes, but its piece of walk still fails there"
+                    if finer.get("piece_passed") is False else "passes"))
     return line
 
 

@@ -73,7 +73,6 @@ from mechc.logic.cubes import DC
 from mechc.parts.pushrod import net_loads
 from mechc.physics.scene import DynSettings
 from mechc.proofs.dynamic import (
-    RECHECKED,
     dynamic_engine,
     plan_changes,
     prove_dynamic,
@@ -229,10 +228,9 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
         failures = calibration_failures(decisions, timed, again, more_rec, st, room,
                                         settings.tolerance, stroke)
         bad += [f["text"] for f in failures]
-    failing = [pairs[i] for i, r in sorted(ran, key=lambda x: x[0])
-               if RECHECKED & set(r["failure_kinds"])]
-    if settings.recheck and failing:  # as the dynamic proof does, in plan order
-        recheck_failures(design, spec, lib, st, rep, failing, settings.tolerance,
+    if settings.recheck and rep.failure_count:  # as the dynamic proof does, in plan order
+        recheck_failures(design, spec, lib, st, rep,
+                         [r for _, r in sorted(ran, key=lambda x: x[0])], settings.tolerance,
                          jobs=settings.jobs, scheduler=settings.scheduler, progress=progress,
                          done_before=len(run))
     cleared = len(pairs) - len(run)

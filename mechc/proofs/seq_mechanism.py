@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -377,9 +377,8 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
         pieces = split_walks(spec, walks, piece_steps)
     else:
         pieces = [Piece(wi, 0, len(w) - 1, 0, w) for wi, w in enumerate(walks)]
-    fails = _Failures()
-    _synthesis_failures(fails, design)
-    figs = _Figures()
+    head = _Failures()  # what fails the design as a whole, listed first
+    _synthesis_failures(head, design)
     done = prefix_steps = 0
     job = WalkJob(design, _types(design), st, trace)
     wants = [expected_after(spec, p.sequence) for p in pieces]
@@ -390,59 +389,104 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
         jobs, scheduler = 1, None
     weights = [len(p.sequence) - 1 for p in pieces]
     results = run_cases(run_walk, job, cases, lib, jobs, scheduler, progress, weights)
-    failing: dict[int, list[str]] = {}  # piece -> its steps a finer solver setting may pass
+    judged: list[tuple[_Failures, _Figures]] = []  # per piece
+    failing: dict[int, dict[str, list[str]]] = {}  # piece -> its steps a finer solver
+    #                                                  setting may pass, and their kinds
     for pi, (p, want, steps) in enumerate(zip(pieces, wants, results)):
-        seq = p.sequence
-        cur = {k: float(v) for k, v in seq[0].items()}
-        for k, (r, binding) in enumerate(steps, start=1):
-            moved = next(n for n in seq[k] if seq[k][n] != cur[n])
-            where = _where(p, k, seq, moved)
+        fails, figs = _Failures(), _Figures()
+        judged.append((fails, figs))
+        for k, (r, where, kinds) in enumerate(_judge_piece(fails, figs, p, want, steps, st,
+                                                           tolerance, mech.ctx.stroke),
+                                              start=1):
             if record is not None:
                 record.append({**where, "final": dict(r.final),
                                "max_violation_mm": r.max_violation,
                                "max_penetration_mm": r.max_penetration,
                                "settle_time_s": r.settle_time, "steps": r.steps,
-                               "binding": binding})
-            kinds = _judge_step(fails, figs, where, r, binding, want[k - 1], want[k], st,
-                                tolerance, mech.ctx.stroke)
+                               "binding": steps[k - 1][1]})
             if RECHECKED & set(kinds):
-                failing.setdefault(pi, []).append(_step_key(where))
-            cur[moved] = float(seq[k][moved])
+                failing.setdefault(pi, {})[_step_key(where)] = kinds
             if k <= p.prefix:
                 prefix_steps += 1
             else:
                 done += 1
     report = ProofReport(
-        level="dynamic", kind="sequential", passed=fails.total == 0, cases=done,
+        level="dynamic", kind="sequential", passed=False, cases=done,
         coverage={"sequences": len(walks), "pieces": len(pieces), "prefix_steps": prefix_steps,
                   "seed": seed, "tolerance_fraction": tolerance},
-        failure_count=fails.total, failure_kinds=fails.counts, failures=fails.items,
-        figures={"max_position_error_fraction": round(figs.max_err, 6),
-                 "max_deviation_fraction": round(figs.dev[0], 6),
-                 "min_margin_fraction": round(0.5 - figs.dev[0], 6),
-                 "max_joint_violation_mm": round(figs.max_vio, 6), "worst_joint": figs.worst,
-                 "max_contact_overrun_mm": round(figs.max_pen, 6),
-                 "max_settle_time_s": round(figs.max_settle, 6), "settings": st.to_json()},
-        seconds=0.0)
+        failure_count=0, failures=[], seconds=0.0)
+    _tally(report, head, judged, st)
     if recheck and failing and trace is None:
-        _recheck_pieces(design, lib, st, report, pieces, wants, failing, tolerance, jobs,
-                        scheduler, progress, sum(weights))
+        _recheck_pieces(design, lib, st, report, pieces, wants, failing, head, judged,
+                        tolerance, jobs, scheduler, progress, sum(weights))
     report.seconds = round(time.perf_counter() - t0, 3)
     return report
 
 
+def _judge_piece(fails: _Failures, figs: _Figures, p: Piece, want: list[dict],
+                 steps: list, st: DynSettings, tolerance: float, stroke: float
+                 ) -> Iterator[tuple[MoveResult, dict, list[str]]]:
+    """Each step of piece ``p`` judged (:func:`_judge_step`) as its run ``steps`` gave it:
+    yields its result, where it is and the kinds it failed on."""
+    seq = p.sequence
+    cur = {k: float(v) for k, v in seq[0].items()}
+    for k, (r, binding) in enumerate(steps, start=1):
+        moved = next(n for n in seq[k] if seq[k][n] != cur[n])
+        where = _where(p, k, seq, moved)
+        kinds = _judge_step(fails, figs, where, r, binding, want[k - 1], want[k], st,
+                            tolerance, stroke)
+        yield r, where, kinds
+        cur[moved] = float(seq[k][moved])
+
+
+def _tally(report: ProofReport, head: _Failures, judged: list[tuple[_Failures, _Figures]],
+           st: DynSettings) -> None:
+    """``report``'s verdict, failures and figures from the design's own failures ``head`` and
+    each piece's: one code path for the proof and for the proof after its re-run proved
+    pieces finer (:func:`_recheck_pieces`)."""
+    items = list(head.items)
+    counts = dict(head.counts)
+    figs = _Figures()
+    for f, g in judged:
+        items += f.items[:max(0, MAX_LISTED - len(items))]
+        for k, n in f.counts.items():
+            counts[k] = counts.get(k, 0) + n
+        if g.max_vio > figs.max_vio:
+            figs.max_vio, figs.worst = g.max_vio, g.worst
+        figs.max_pen = max(figs.max_pen, g.max_pen)
+        figs.max_err = max(figs.max_err, g.max_err)
+        figs.max_settle = max(figs.max_settle, g.max_settle)
+        figs.dev[0] = max(figs.dev[0], g.dev[0])
+    report.failure_count = sum(counts.values())
+    report.passed = report.failure_count == 0
+    report.failure_kinds = counts
+    report.failures = items
+    report.figures = {
+        **report.figures,
+        "max_position_error_fraction": round(figs.max_err, 6),
+        "max_deviation_fraction": round(figs.dev[0], 6),
+        "min_margin_fraction": round(0.5 - figs.dev[0], 6),
+        "max_joint_violation_mm": round(figs.max_vio, 6), "worst_joint": figs.worst,
+        "max_contact_overrun_mm": round(figs.max_pen, 6),
+        "max_settle_time_s": round(figs.max_settle, 6), "settings": st.to_json()}
+
+
 def _recheck_pieces(design: Design, lib: Library, st: DynSettings, report: ProofReport,
                     pieces: list[Piece], wants: list[list[dict]],
-                    failing: dict[int, list[str]], tolerance: float, jobs: int,
+                    failing: dict[int, dict[str, list[str]]], head: _Failures,
+                    judged: list[tuple[_Failures, _Figures]], tolerance: float, jobs: int,
                     scheduler: str | None, progress: Callable[[int, int], None] | None,
                     done_before: int) -> None:
     """Run the first ``RECHECK_MAX`` ``failing`` pieces (piece index -> the keys of its steps
-    that failed on solver, contact or settle) again, whole and from power-up as before, at
-    twice ``st``'s iterations, and note in ``report`` what their failing steps gave: a step
-    that passes there failed by the solver. A piece runs whole because its state at a step
-    is the walk's up to it. Each failure entry of such a step gains ``finer``; the figures
-    gain ``recheck``, counting steps; the verdict and the failure counts stay the proof's
-    own. ``progress`` goes on from ``done_before`` steps."""
+    that failed on solver, contact or settle, and the kinds each failed on) again, whole and
+    from power-up as before, at twice ``st``'s iterations, and prove them there. A piece runs
+    whole because its state at a step is the walk's up to it. A piece whose every step passes
+    there failed by the solver: its finer run replaces its first in ``judged`` and ``report``
+    is tallied again (``head``: the design's own failures), so its failures are gone and
+    ``recheck`` lists its steps that had failed. In a piece that still fails, each failure
+    entry of such a step gains ``finer`` (what the re-run gave; a step may pass there in a
+    piece that does not). The figures' ``recheck`` counts steps: ``passed_finer`` those
+    proved. ``progress`` goes on from ``done_before`` steps."""
     chosen = sorted(failing)[:RECHECK_MAX]
     finer = replace(st, iterations=2 * st.iterations)
     job = WalkJob(design, _types(design), finer, None)
@@ -454,31 +498,34 @@ def _recheck_pieces(design: Design, lib: Library, st: DynSettings, report: Proof
             progress(done_before + done, done_before + total)
 
     results = run_cases(run_walk, job, cases, lib, jobs, scheduler, tick, weights)
-    scratch, figs = _Failures(), _Figures()
     by_step: dict[str, dict] = {}
+    proved: list[dict] = []
     for i, steps in zip(chosen, results):
-        p, want, keep = pieces[i], wants[i], set(failing[i])
-        seq = p.sequence
-        cur = {k: float(v) for k, v in seq[0].items()}
-        for k, (r, binding) in enumerate(steps, start=1):
-            moved = next(n for n in seq[k] if seq[k][n] != cur[n])
-            where = _where(p, k, seq, moved)
-            kinds = _judge_step(scratch, figs, where, r, binding, want[k - 1], want[k], finer,
-                                tolerance, design.mechanism.ctx.stroke)
-            if (key := _step_key(where)) in keep:
+        fails, figs = _Failures(), _Figures()
+        mine: list[dict] = []
+        for r, where, kinds in _judge_piece(fails, figs, pieces[i], wants[i], steps, finer,
+                                            tolerance, design.mechanism.ctx.stroke):
+            if (key := _step_key(where)) in failing[i]:
                 by_step[key] = {
                     "iterations": finer.iterations, "passed": not kinds,
                     "failure_kinds": kinds, "max_violation_mm": round(r.max_violation, 6),
                     "max_penetration_mm": round(r.max_penetration, 6),
                     "settle_time_s": (round(r.settle_time, 5) if math.isfinite(r.settle_time)
                                       else None)}
-            cur[moved] = float(seq[k][moved])
+                mine.append({**where, "failure_kinds_at_settings": failing[i][key],
+                             **by_step[key]})
+        for x in mine:
+            by_step[_step_key(x)]["piece_passed"] = fails.total == 0
+        if fails.total == 0:  # the whole piece passes finer: proved there
+            judged[i] = (fails, figs)
+            proved += mine
+    if proved:
+        _tally(report, head, judged, st)
     for f in report.failures:
         if "sequence" in f and (key := _step_key(f)) in by_step:
             f["finer"] = by_step[key]
-    passed = sum(x["passed"] for x in by_step.values())
     report.figures["recheck"] = {
-        "iterations": finer.iterations, "changes": len(by_step), "passed_finer": passed,
-        "failed_finer": len(by_step) - passed,
+        "iterations": finer.iterations, "changes": len(by_step), "passed_finer": len(proved),
+        "failed_finer": len(by_step) - len(proved),
         "not_rechecked": sum(len(failing[i]) for i in failing if i not in set(chosen)),
-        "cap": RECHECK_MAX}
+        "cap": RECHECK_MAX, "proved_finer": proved[:MAX_LISTED]}
