@@ -79,9 +79,10 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
     s.add_argument("--no-recheck", dest="recheck", action="store_false",
                    help="dynamic and screened: do not run the changes failing on a joint "
                    "stretch, contact overrun or late settle again at twice the iterations "
-                   f"(by default the first {RECHECK_MAX} are, to tell the solver's failures "
-                   "from the mechanism's; each costs about twice a change at the proof's "
-                   "settings)")
+                   f"(by default the first {RECHECK_MAX} are: one that passes every check "
+                   "there failed by the solver and is proved there, counted as passed; one "
+                   "that still fails is listed as failing. Each costs about twice a change "
+                   "at the proof's settings)")
     s.add_argument("--prune", action="store_true",
                    help="dynamic: run each input change on a scene of only the cells it can "
                    "move (see docs/performance.md)")

@@ -15,7 +15,8 @@ cluster run them (``mechc.proofs.parallel``) and the report is the serial run's,
 With ``prune`` each change runs on a scene of only the cells that can move the outputs
 (``mechc.proofs.prune``); off by default, see docs/performance.md for why. The first
 ``RECHECK_MAX`` changes failing on solver, contact or settle run again at twice the iterations
-(:func:`recheck_failures`): the report says which failures were the solver's.
+(:func:`recheck_failures`): one that passes every check there failed by the solver, is proved
+there and counts as passed; the report says which.
 """
 
 from __future__ import annotations
@@ -253,8 +254,8 @@ def prove_dynamic(design: Design, spec: Spec, lib: Library, settings: DynSetting
     ``freeze``: which still bodies a pruned
     scene holds static (``mechc.proofs.prune.build_scene``; default ``prune.FREEZE``).
     ``recheck``: the changes failing on a kind the solver may cause run again at twice the
-    iterations (:func:`recheck_failures`; not on one scene nor with a trace); it adds to the
-    report, it never changes the verdict."""
+    iterations (:func:`recheck_failures`; not on one scene nor with a trace); one passing
+    every check there is proved there and counts as passed."""
     t0 = time.perf_counter()
     st = settings or dyn_settings(design, lib)
     if design.mechanism is None:

@@ -166,23 +166,29 @@ def recheck_text(r: dict) -> list[str]:
     if not rc:
         return []
     it, k, ok = rc["iterations"], rc["changes"], rc["passed_finer"]
-    bad = k - ok
+    loose = rc.get("passed_unproved", 0)  # a sequential step passing in a piece that fails
+    bad = k - ok - loose
     fails = "fails" if bad == 1 else "fail"
     parts = [f"{ok} of {k} failing change{'' if k == 1 else 's'} "
              f"{'passes' if ok == 1 else 'pass'} there"]
     if ok:
         parts[0] += (f" (the solver's: proved at {it} iterations, "
                      f"{'it counts' if ok == 1 else 'they count'} as passed)")
+    if loose:
+        parts.append(f"{loose} {'passes' if loose == 1 else 'pass'} there in a piece of walk "
+                     "that still fails at another step (not proved)")
     if bad:
         who = "(the mechanism's, or the solver's at finer settings still)"
-        parts.append(f"{bad} still {fails} {who}" if ok
+        parts.append(f"{bad} still {fails} {who}" if ok or loose
                      else f"{'it' if k == 1 else 'all'} still {fails} {who}")
     lines = [f"re-run at {it} iterations: " + ", ".join(parts)]
     base = (r.get("settings") or {}).get("iterations", it // 2)
     lines += ["  " + failure_text({
         "kind": f"proved at {it} iterations", "inputs": p["inputs"], "moving": p["moving"],
-        "to": p["to"], "message": f"(failed on {', '.join(p['failure_kinds_at_settings'])} at "
-                                  f"{base})"}) for p in rc.get("proved_finer", [])[:SHOWN_FAILURES]]
+        "to": p["to"],
+        "message": (f"in walk {p['sequence']} step {p['step']} " if "sequence" in p else "")
+        + f"(failed on {', '.join(p['failure_kinds_at_settings'])} at {base})"})
+        for p in rc.get("proved_finer", [])[:SHOWN_FAILURES]]
     if rc.get("not_rechecked"):
         lines.append(f"{rc['not_rechecked']} more such failing changes were not re-run (at "
                      f"most {rc['cap']} are): " + " ".join(solver_hint(r)))

@@ -367,7 +367,7 @@ def prove_sequential_dynamic(design: Design, spec, lib: Library,
     body's pose at power-up and along every step (the walks then run whole, in this
     process). ``recheck``: the first ``RECHECK_MAX`` pieces holding a step that failed on a
     kind the solver may cause run again at twice the iterations (:func:`_recheck_pieces`;
-    not with a trace); it adds to the report, it never changes the verdict."""
+    not with a trace); a piece passing every check there is proved there."""
     t0 = time.perf_counter()
     mech = design.mechanism
     st = settings or dyn_settings(design, lib)
@@ -486,7 +486,8 @@ def _recheck_pieces(design: Design, lib: Library, st: DynSettings, report: Proof
     ``recheck`` lists its steps that had failed. In a piece that still fails, each failure
     entry of such a step gains ``finer`` (what the re-run gave; a step may pass there in a
     piece that does not). The figures' ``recheck`` counts steps: ``passed_finer`` those
-    proved. ``progress`` goes on from ``done_before`` steps."""
+    proved, ``passed_unproved`` those passing in a piece that does not. ``progress`` goes
+    on from ``done_before`` steps."""
     chosen = sorted(failing)[:RECHECK_MAX]
     finer = replace(st, iterations=2 * st.iterations)
     job = WalkJob(design, _types(design), finer, None)
@@ -524,8 +525,9 @@ def _recheck_pieces(design: Design, lib: Library, st: DynSettings, report: Proof
     for f in report.failures:
         if "sequence" in f and (key := _step_key(f)) in by_step:
             f["finer"] = by_step[key]
+    failed = sum(not x["passed"] for x in by_step.values())
     report.figures["recheck"] = {
         "iterations": finer.iterations, "changes": len(by_step), "passed_finer": len(proved),
-        "failed_finer": len(by_step) - len(proved),
+        "failed_finer": failed, "passed_unproved": len(by_step) - len(proved) - failed,
         "not_rechecked": sum(len(failing[i]) for i in failing if i not in set(chosen)),
         "cap": RECHECK_MAX, "proved_finer": proved[:MAX_LISTED]}

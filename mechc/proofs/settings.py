@@ -39,8 +39,8 @@ class ProofSettings:
     #                            its move; None: the design's own (mechc.proofs.hold)
     # dynamic, screened: the changes failing on a joint stretch, contact overrun or late settle
     # run again at twice the iterations (mechc.proofs.dynamic.recheck_failures; a sequential
-    # design: the pieces of walks holding such a step, mechc.proofs.seq_mechanism); adds to
-    # the report, never changes its verdict
+    # design: the pieces of walks holding such a step, mechc.proofs.seq_mechanism); one that
+    # passes every check there is proved there and counts as passed
     recheck: bool = True
     # dynamic: processes the cases run on, or the address of a Dask scheduler to run them on
     # (mechc.proofs.parallel); neither changes what the proof reports
