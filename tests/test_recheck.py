@@ -168,6 +168,17 @@ def test_a_design_whose_failures_are_all_the_solvers_passes(adder, cli, tmp_path
     assert code == 1 and "FAILED" in out
 
 
+def test_the_screened_proof_proves_the_same_changes_finer(adder):
+    """The screened proof re-runs after its rounds as the dynamic proof does: at three
+    iterations both pass, with the same changes proved at six."""
+    def proved(r: ProofReport) -> set[tuple]:
+        return {_key(p) for p in r.figures["recheck"]["proved_finer"]}
+
+    scr = prove(adder, adder.spec, LIB, "screened", ProofSettings(iterations=3, jobs=2))
+    dyn = prove(adder, adder.spec, LIB, "dynamic", ProofSettings(iterations=3, jobs=2))
+    assert scr.passed and dyn.passed and proved(scr) == proved(dyn) != set()
+
+
 def test_a_settle_failure_of_the_mechanism_still_fails_finer_in_the_screened_proof(adder):
     """Inputs thrown in 10 ms: the screened proof (its own rounds, then one recheck) keeps the
     dynamic proof's verdict, and its re-run at 120 iterations still fails every change."""
