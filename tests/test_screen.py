@@ -379,6 +379,26 @@ def amplified():
     return compile_netlist(spec, nl, library=LIB)
 
 
+def test_a_table_measured_as_built_for_the_screen_shows_progress(amplified, tmp_path,
+                                                                 monkeypatch):
+    """An AMPLIFIER is timed as built, measured on its first use in the screen's timing of
+    the changes (about a minute each on adder16's): the proof's progress is told so, naming
+    the instance, before the first change runs; with its table cached, nothing is measured."""
+    monkeypatch.setenv("MECHC_CACHE_DIR", str(tmp_path))
+    seen: list[tuple] = []
+    rep = prove(amplified, amplified.spec, LIB, "screened", ProofSettings(jobs=1),
+                lambda done, total, *what: seen.append((done, total, *what)))
+    assert rep.passed, rep.failures[:3]
+    g1 = [s for s in seen if len(s) == 3 and "cell 'g1'" in s[2]]
+    changes = [s for s in seen if len(s) == 2]
+    assert g1 and changes and seen.index(g1[-1]) < seen.index(changes[0])
+    assert g1[-1][0] == g1[-1][1] and "(first use)" in g1[-1][2]
+    seen.clear()
+    prove(amplified, amplified.spec, LIB, "screened", ProofSettings(jobs=1),
+          lambda done, total, *what: seen.append((done, total, *what)))
+    assert not [s for s in seen if len(s) == 3]  # cached now
+
+
 @pytest.mark.slow
 def test_amplifier_changes_are_cleared_by_their_as_built_table(amplified, tmp_path,
                                                                monkeypatch):

@@ -173,7 +173,7 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
                             move_time=settings.move_time, hold=settings.hold,
                             progress=progress)
     n = len(spec.inputs)
-    pairs, timed, decisions = decide(design, spec, lib, settings, st)
+    pairs, timed, decisions = decide(design, spec, lib, settings, st, progress)
     budget = st.move_time + st.settle_time
     held_margin = HELD_MARGIN_SHARE * settings.tolerance
     run = [i for i, d in enumerate(decisions) if d["route"] == "dynamic"]
@@ -265,16 +265,19 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
     return rep
 
 
-def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st: DynSettings
+def decide(design: Design, spec: Spec, lib: Library, settings: ProofSettings, st: DynSettings,
+           progress: OnProgress | None = None
            ) -> tuple[list[tuple[int, int]], list[dict], list[dict]]:
     """The dynamic proof's plan, each change timed, and each change's route (``dynamic`` or
-    ``timing``) with the reasons it must run in pymunk."""
+    ``timing``) with the reasons it must run in pymunk. ``progress`` is told (done, total,
+    what) while a cell's table is measured (first use; a cell timed as built, such as an
+    AMPLIFIER, about a minute each)."""
     nl = design.netlist
     names = list(spec.inputs)
     n = len(names)
     pairs, _chosen = plan_changes(design, names, settings.cases, settings.seed,
                                   independent=True)
-    tables, _tabs = cell_tables(design, lib, None, names, pairs)
+    tables, _tabs = cell_tables(design, lib, progress, names, pairs)
     timed = predict_changes(design, lib, names, pairs, st, tables, detail=True)
     before = spec.values_at(_columns([a for a, _ in pairs], n))
     after = spec.values_at(_columns([b for _, b in pairs], n))
