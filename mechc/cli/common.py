@@ -144,6 +144,8 @@ def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = Tru
     if not mechanism and getattr(spec, "kind", "") == "fsm":
         return compile_sequential(spec, options_from_args(args), mechanism=False)
     opts = options_from_args(args)
+    if not getattr(args, "levels", None):  # the file compiled decides, whichever command
+        opts.levels = default_levels(spec_path)  # (simulate's --spec names another file)
     if getattr(spec, "network", None) is not None and not getattr(args, "levels", None):
         opts.levels = "multi"  # too wide for a table: multi-level is the one way to build it
     if stages is None:
