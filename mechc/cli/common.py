@@ -145,9 +145,10 @@ def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = Tru
         return compile_sequential(spec, options_from_args(args), mechanism=False)
     opts = options_from_args(args)
     if not getattr(args, "levels", None):  # the file compiled decides, whichever command
-        opts.levels = default_levels(spec_path)  # (simulate's --spec names another file)
-    if getattr(spec, "network", None) is not None and not getattr(args, "levels", None):
-        opts.levels = "multi"  # too wide for a table: multi-level is the one way to build it
+        #                                       (simulate's --spec names another file); too
+        #  wide for a table, multi-level is the one way to build it
+        opts.levels = ("multi" if getattr(spec, "network", None) is not None
+                       else default_levels(spec_path))
     if stages is None:
         return compile_spec(spec, opts)
     return compile_spec(spec, opts, progress=stages.start, done=stages.end)

@@ -395,6 +395,15 @@ def tally(outcomes: list[dict]) -> tuple[list[dict], dict[str, int], dict]:
     return failures, counts, fig
 
 
+def finer_entry(iterations: int, kinds: list[str], violation: float, penetration: float,
+                settle: float) -> dict:
+    """What a re-run at finer settings gave for one change or step, as the report keeps it
+    (``finer`` on a failure, an entry of ``recheck.proved_finer``)."""
+    return {"iterations": iterations, "passed": not kinds, "failure_kinds": kinds,
+            "max_violation_mm": round(violation, 6), "max_penetration_mm": round(penetration, 6),
+            "settle_time_s": round(settle, 5) if math.isfinite(settle) else None}
+
+
 def recheck_failures(design: Design, spec: Spec, lib: Library, st: DynSettings,
                      report: ProofReport, outcomes: list[dict], tolerance: float,
                      prune: bool = False, cells: list[str] | None = None,
@@ -433,12 +442,8 @@ def recheck_failures(design: Design, spec: Spec, lib: Library, st: DynSettings,
             run.result, ch, case["moving"], finer, tolerance, design.mechanism.ctx.stroke))
 
     def summary(o: dict) -> dict:
-        return {"iterations": finer.iterations, "passed": not o["failures"],
-                "failure_kinds": o["failure_kinds"],
-                "max_violation_mm": round(o["max_violation_mm"], 6),
-                "max_penetration_mm": round(o["max_penetration_mm"], 6),
-                "settle_time_s": (round(o["settle_time_s"], 5)
-                                  if math.isfinite(o["settle_time_s"]) else None)}
+        return finer_entry(finer.iterations, o["failure_kinds"], o["max_violation_mm"],
+                           o["max_penetration_mm"], o["settle_time_s"])
 
     proved = {pair for pair, o in again.items() if not o["failures"]}
     if proved:  # the report as if those changes had run finer from the start

@@ -29,7 +29,7 @@ from mechc.parts.poses import PoseSink
 from mechc.physics.closed_form import KinematicsError
 from mechc.physics.evaluate import output_signals, settle
 from mechc.physics.scene import DynSettings, MoveResult, Scene
-from mechc.proofs.dynamic import RECHECK_MAX, RECHECKED
+from mechc.proofs.dynamic import RECHECK_MAX, RECHECKED, finer_entry
 from mechc.proofs.parallel import run_cases
 from mechc.proofs.registry import OnProgress, engine
 from mechc.proofs.report import ProofReport
@@ -507,12 +507,8 @@ def _recheck_pieces(design: Design, lib: Library, st: DynSettings, report: Proof
         for r, where, kinds in _judge_piece(fails, figs, pieces[i], wants[i], steps, finer,
                                             tolerance, design.mechanism.ctx.stroke):
             if (key := _step_key(where)) in failing[i]:
-                by_step[key] = {
-                    "iterations": finer.iterations, "passed": not kinds,
-                    "failure_kinds": kinds, "max_violation_mm": round(r.max_violation, 6),
-                    "max_penetration_mm": round(r.max_penetration, 6),
-                    "settle_time_s": (round(r.settle_time, 5) if math.isfinite(r.settle_time)
-                                      else None)}
+                by_step[key] = finer_entry(finer.iterations, kinds, r.max_violation,
+                                           r.max_penetration, r.settle_time)
                 mine.append({**where, "failure_kinds_at_settings": failing[i][key],
                              **by_step[key]})
         for x in mine:
