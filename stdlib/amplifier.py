@@ -45,6 +45,7 @@ from mechc.cells.springs import design_coil
 from mechc.errors import DesignError
 from mechc.ir.check import Check
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Part, Point, Spring, SynthContext
+from mechc.parts.contact import hold_with_slop
 from mechc.parts.lever import Lever
 from mechc.physics.closed_form import solve
 from mechc.physics.scene import FAR, N
@@ -528,6 +529,10 @@ class Amplifier(Cell):
         for c in scene.space.constraints:
             if tb in (c.a, c.b):
                 c.error_bias = STOP_ERROR_BIAS
+        # ... and hold it there: corrected to the edge, a stop let the toggle spring kick T
+        for c in list(scene.space.constraints):
+            if isinstance(c, pymunk.SlideJoint) and tb in (c.a, c.b):  # its stops (contacts)
+                hold_with_slop(scene.space, c)
         _add_wedge_clutches(scene, part, toggle)
         c = part.data["design"].get("dashpot", 0.0)
         if c > 0.0:

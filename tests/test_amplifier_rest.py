@@ -1,0 +1,93 @@
+"""An AMPLIFIER at rest stays at rest. pymunk corrects a stop's overrun towards none at all,
+and a slide joint acts only past its limit: a toggle its spring presses onto a stop ended, by
+rounding, a hair outside it, the stop let go for a step, and the spring's whole torque kicked
+the toggle (about 5 rad/s, its output 0.04 mm) every 75-300 ms. In the 16-bit adder those
+kicks, passed on through the gates, kept held outputs off their closed form by up to 0.011 of
+the stroke, so no change ever settled before the end of its hold. Stops held with a slop
+(:func:`mechc.parts.contact.hold_with_slop`) rest a hair in instead."""
+
+from __future__ import annotations
+
+import numpy as np
+import pymunk
+import pytest
+
+from mechc.cells.library import load_library
+from mechc.frontends.boolfile import parse_bool
+from mechc.parts.contact import FAR, SLOP, hold_with_slop
+from mechc.physics.scene import DynSettings, Scene
+from mechc.pipeline import compile_spec
+
+LIB = load_library()
+
+
+@pytest.fixture(scope="module")
+def adder2():
+    """a1 a0 + b1 b0 + cin = s2 s1 s0, compiled: three amplifiers hold the carries' loads."""
+    on: dict[str, list[int]] = {"s2": [], "s1": [], "s0": []}
+    for row in range(32):
+        total = ((row >> 3) & 3) + ((row >> 1) & 3) + (row & 1)
+        for bit, o in ((2, "s2"), (1, "s1"), (0, "s0")):
+            if (total >> bit) & 1:
+                on[o].append(row)
+    text = "inputs a1 a0 b1 b0 cin\noutputs s2 s1 s0\n" + "".join(
+        f"{o} = minterms({', '.join(map(str, v))})\n" for o, v in on.items())
+    return compile_spec(parse_bool(text, "<adder2>"))
+
+
+@pytest.mark.parametrize("state", [0b00000, 0b10110, 0b11111])
+def test_held_toggles_do_not_kick(adder2, state):
+    """A second at rest: after the first 50 ms (the scene settling from its closed-form start)
+    no toggle turns faster than 1 rad/s. Before the stops held with a slop the three toggles
+    passed 1 rad/s in 32-70 steps of such a second, in each of these start states."""
+    d = adder2
+    assert sum(c.type == "AMPLIFIER" for c in d.netlist.cells.values()) >= 2
+    names = list(d.spec.inputs)
+    start = {nm: float((state >> (len(names) - 1 - k)) & 1) for k, nm in enumerate(names)}
+    st = DynSettings()
+    types = {c.id: c.cell for c in d.netlist.cells.values()}
+    sc = Scene.build(d.mechanism, LIB, types, st, start)
+    toggles = [b for bid, b in sc.bodies.items() if bid.endswith(".T")]
+    fast = 0
+    for step in range(int(1.0 / st.dt)):
+        sc.space.step(st.dt)
+        if step * st.dt > 0.05:
+            fast += sum(abs(t.angular_velocity) > 1.0 for t in toggles)
+    assert fast == 0
+
+
+def _pressed_body(x0: float, force: float, slop: bool) -> tuple[int, float]:
+    """A 20 g body a constant ``force`` (N, pymunk units) presses onto a contact at ``x0``
+    (mm), the amplifier's error bias on the stop, one second: the steps it moved faster than
+    1 mm/s after the first 50 ms, and how far in it rests."""
+    from mechc.stdlib.amplifier import STOP_ERROR_BIAS
+
+    dt = 2.5e-4
+    sp = pymunk.Space()
+    sp.iterations = 60
+    body = pymunk.Body(0.02, pymunk.moment_for_circle(0.02, 0.0, 5.0))
+    body.position = (x0, 0.0)
+    sp.add(body, pymunk.GrooveJoint(sp.static_body, body, (x0 - 100.0, 0.0),
+                                    (x0 + 100.0, 0.0), (0.0, 0.0)))
+    stop = pymunk.SlideJoint(sp.static_body, body, (x0 + FAR, 0.0), (0.0, 0.0), FAR,
+                             FAR + 1000.0)  # as mechc.parts.contact builds a stop
+    stop.error_bias = STOP_ERROR_BIAS
+    sp.add(stop)
+    if slop:
+        hold_with_slop(sp, stop)
+    kicks = 0
+    for i in range(int(1.0 / dt)):
+        body.apply_force_at_local_point((force, 0.0))
+        sp.step(dt)
+        kicks += i * dt > 0.05 and abs(body.velocity.x) > 1.0
+    return kicks, body.position.x - x0
+
+
+def test_a_stop_held_with_a_slop_never_lets_go():
+    """Wherever the stop stands (rounding differs) and however hard the body is pressed, a
+    stop held with a slop never lets the body go, and holds it in by at most ``SLOP``."""
+    for x0 in np.linspace(0.0, 2000.0, 9):
+        for force in (200.0, 2000.0):
+            kicks, rest = _pressed_body(float(x0), force, slop=True)
+            assert kicks == 0, (x0, force)
+            assert 0.0 < rest <= SLOP * 1.001, (x0, force, rest)
