@@ -21,6 +21,7 @@ from mechc.pipeline import compile_sequential, compile_spec
 from mechc.proofs import ProofSettings, dyn_settings, prove
 from mechc.proofs.dynamic import RECHECK_MAX, RECHECKED, prove_dynamic
 from mechc.proofs.report import ProofReport, failure_text, recheck_text
+from mechc.proofs.screen import JOINT_HEADROOM
 from mechc.proofs.seq_logic import split_walks, transition_tour
 from mechc.proofs.seq_mechanism import prove_sequential_dynamic
 from tests.helpers import EXAMPLES
@@ -199,7 +200,48 @@ def test_a_settle_failure_of_the_mechanism_still_fails_finer_in_the_screened_pro
     assert "can be the solver's" not in scr.summary_text()  # every such failure re-ran
     # the progress goes on from the proof's changes to the re-run's, never back
     done = [d for d, _ in seen]
-    assert done == sorted(done) and seen[-1][0] == seen[-1][1] == 23 + len(rechecked)
+    # (and the witnesses its calibration ran again finer: those that only stretched a joint)
+    again = scr.figures["screen"]["rerun_finer"]
+    assert done == sorted(done) and seen[-1][0] == seen[-1][1] == 23 + again + len(rechecked)
+
+
+@pytest.fixture(scope="module")
+def sorter():
+    return compile_spec(load_spec(EXAMPLES / "sorter.bool"))
+
+
+def test_a_witness_the_solver_stretched_witnesses_at_twice_the_iterations(sorter):
+    """At two iterations the sorter's witnesses stretch joints past the headroom the changes
+    they vouch for need; at four they leave it. The screen runs them again there instead of
+    running every change they vouch for, and the changes it clears on them pass every check
+    of the whole dynamic proof at four iterations, run independently. The verdict is the
+    dynamic proof's, which proves its own failing changes at four."""
+    s = ProofSettings(iterations=2, jobs=2)
+    scr = prove(sorter, sorter.spec, LIB, "screened", s)
+    sc = scr.figures["screen"]
+    w = sc["witnessed_finer"]
+    assert w and all(e["iterations"] == 4 and e["passed"]
+                     and e["max_violation_mm"] <= (1 - JOINT_HEADROOM) * 0.1 for e in w)
+    assert all("joint stretch" in t for e in w for t in e["failed_at_settings"])
+    at4 = [d for d in sc["decisions"] if d.get("witness_iterations") == 4]
+    assert len(at4) == sc["cleared_finer"] > 0 and all(d["route"] == "timing" for d in at4)
+    assert sc["fell_back"] == 0 and sc["dynamic"] < len(at4)
+    truth = _finer_truth(sorter, 4)
+    assert all(truth[_key(d)] == [] for d in at4)
+    dyn = prove(sorter, sorter.spec, LIB, "dynamic", s)
+    assert scr.passed and dyn.passed
+    assert f"the {len(at4)} cleared changes they vouch for are proved at 4 iterations" \
+        in sc["text"]
+
+
+def test_no_recheck_keeps_the_witnesses_at_the_proofs_settings(sorter):
+    """With the re-run off the witnesses are judged at two iterations: their failures take
+    the vouching from every change they concern, which then run."""
+    scr = prove(sorter, sorter.spec, LIB, "screened",
+                ProofSettings(iterations=2, jobs=2, recheck=False))
+    sc = scr.figures["screen"]
+    assert sc["witnessed_finer"] == [] and sc["cleared_finer"] == 0
+    assert sc["fell_back"] > 0 and sc["calibration"] != "passed"
 
 
 def test_the_recheck_line_reads_plainly():
