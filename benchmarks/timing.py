@@ -28,11 +28,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from mechc.bench.circuits import EXAMPLES, random_compiled  # noqa: E402
+from mechc.bench.circuits import EXAMPLES, adder2_spec, random_compiled  # noqa: E402
 from mechc.cells.characterise import crossing, settled_at  # noqa: E402
 from mechc.cells.library import load_library  # noqa: E402
 from mechc.frontends import load_spec  # noqa: E402
-from mechc.frontends.boolfile import parse_bool  # noqa: E402
 from mechc.passes.assemble import MechOptions  # noqa: E402
 from mechc.physics.scene import Scene  # noqa: E402
 from mechc.pipeline import CompileOptions, compile_spec  # noqa: E402
@@ -43,20 +42,6 @@ from mechc.proofs.timing import cell_tables, predict_changes, prove_timing  # no
 LIB = load_library()
 ROOT = Path(__file__).resolve().parents[1]
 BAND = 0.15
-
-
-def adder2_spec():
-    """a1 a0 + b1 b0 + cin = s2 s1 s0, as a .bool spec."""
-    on: dict[str, list[int]] = {"s2": [], "s1": [], "s0": []}
-    for row in range(32):
-        a, b, c = (row >> 3) & 3, (row >> 1) & 3, row & 1
-        s = a + b + c
-        for bit, o in ((2, "s2"), (1, "s1"), (0, "s0")):
-            if (s >> bit) & 1:
-                on[o].append(row)
-    text = "inputs a1 a0 b1 b0 cin\noutputs s2 s1 s0\n" + "".join(
-        f"{o} = minterms({', '.join(map(str, v))})\n" for o, v in on.items())
-    return parse_bool(text, "<adder2>")
 
 
 def circuits(quick: bool, extra: list[str] = ()) -> list[tuple[str, object, int | None]]:

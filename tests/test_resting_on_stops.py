@@ -12,8 +12,8 @@ import numpy as np
 import pymunk
 import pytest
 
+from mechc.bench.circuits import adder2_spec
 from mechc.cells.library import load_library
-from mechc.frontends.boolfile import parse_bool
 from mechc.parts.contact import FAR, SLOP, hold_with_slop
 from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_spec
@@ -24,15 +24,7 @@ LIB = load_library()
 @pytest.fixture(scope="module")
 def adder2():
     """a1 a0 + b1 b0 + cin = s2 s1 s0, compiled: three amplifiers hold the carries' loads."""
-    on: dict[str, list[int]] = {"s2": [], "s1": [], "s0": []}
-    for row in range(32):
-        total = ((row >> 3) & 3) + ((row >> 1) & 3) + (row & 1)
-        for bit, o in ((2, "s2"), (1, "s1"), (0, "s0")):
-            if (total >> bit) & 1:
-                on[o].append(row)
-    text = "inputs a1 a0 b1 b0 cin\noutputs s2 s1 s0\n" + "".join(
-        f"{o} = minterms({', '.join(map(str, v))})\n" for o, v in on.items())
-    return compile_spec(parse_bool(text, "<adder2>"))
+    return compile_spec(adder2_spec())
 
 
 @pytest.mark.parametrize("state", [0b00000, 0b10110, 0b11111])

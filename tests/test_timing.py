@@ -260,17 +260,9 @@ def test_an_internal_net_settles_from_its_own_closed_form():
     switches mid-move; timing its landing from the move's end put the 2-bit adder's carry
     changes 20-40 % late (every one sent to pymunk for want of slack). From the net's own
     closed form the latest net settles within 15 % of the whole scene's outputs."""
-    from mechc.frontends.boolfile import parse_bool
+    from mechc.bench.circuits import adder2_spec
 
-    on: dict[str, list[int]] = {"s2": [], "s1": [], "s0": []}
-    for row in range(32):
-        s = ((row >> 3) & 3) + ((row >> 1) & 3) + (row & 1)
-        for bit, o in ((2, "s2"), (1, "s1"), (0, "s0")):
-            if (s >> bit) & 1:
-                on[o].append(row)
-    text = "inputs a1 a0 b1 b0 cin\noutputs s2 s1 s0\n" + "".join(
-        f"{o} = minterms({', '.join(map(str, v))})\n" for o, v in on.items())
-    d = compile_spec(parse_bool(text, "<adder2>"))
+    d = compile_spec(adder2_spec())
     names = list(d.spec.inputs)
     st = dyn_settings(d)
     amps = {c.id for c in d.netlist.cells.values() if c.type == "AMPLIFIER"}

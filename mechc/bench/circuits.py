@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from mechc.frontends import load_spec
+from mechc.frontends.boolfile import parse_bool
 from mechc.frontends.fsm import parse_fsm_file
 from mechc.ir.design import Design
 from mechc.ir.netlist import CellInst, Netlist
@@ -32,6 +33,20 @@ EXAMPLES = ROOT / "examples"
 TYPES = ["AND", "OR", "NAND", "NOR", "AND_NOT", "OR_NOT", "NOT"]
 CELL_OF = {"AND": "and", "OR": "or", "NAND": "nand", "NOR": "nor", "AND_NOT": "and_not",
            "OR_NOT": "or_not", "NOT": "not", "XOR": "xor"}
+
+
+def adder2_spec() -> Spec:
+    """a1 a0 + b1 b0 + cin = s2 s1 s0, as a .bool spec: the 2-bit adder with carry-in of the
+    timing and screen benchmarks (its carries go through AMPLIFIERs once compiled)."""
+    on: dict[str, list[int]] = {"s2": [], "s1": [], "s0": []}
+    for row in range(32):
+        total = ((row >> 3) & 3) + ((row >> 1) & 3) + (row & 1)
+        for bit, o in ((2, "s2"), (1, "s1"), (0, "s0")):
+            if (total >> bit) & 1:
+                on[o].append(row)
+    text = "inputs a1 a0 b1 b0 cin\noutputs s2 s1 s0\n" + "".join(
+        f"{o} = minterms({', '.join(map(str, v))})\n" for o, v in on.items())
+    return parse_bool(text, "<adder2>")
 
 
 def random_netlist(n_cells: int, n_inputs: int = 6, seed: int = 0, max_depth: int = 5,
