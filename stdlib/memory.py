@@ -17,11 +17,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pymunk
 
 from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.cells.springs import design_coil
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Spring
+from mechc.parts.contact import hold_with_slop
 from mechc.parts.lever import Lever
 from mechc.parts.rod import slider_from_rod
 from mechc.physics.closed_form import KinematicsError, Poses
@@ -206,6 +208,10 @@ def _stiff_stops(scene, part) -> None:
     for c in scene.space.constraints:
         if lb in (c.a, c.b):
             c.error_bias = STOP_ERROR_BIAS
+    # ... and hold it there: corrected to the edge, a stop let the detent kick the lever
+    for c in list(scene.space.constraints):
+        if isinstance(c, pymunk.SlideJoint) and lb in (c.a, c.b):  # its stops (contacts)
+            hold_with_slop(scene.space, c)
 
 
 def _stop(b: Builder, lever: str, at, point, nx: float) -> Joint:

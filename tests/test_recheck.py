@@ -277,8 +277,11 @@ def test_no_recheck_is_refused_where_no_dynamic_proof_runs(cli):
 
 
 # ---- the sequential dynamic proof: pieces of walks run again, steps counted -------------------
-# The gated latch at one iteration per step: 42 of its 66 steps (3 of them on the way to a
-# piece's start) break a joint; at two, 20 do. It runs in about 3 s on two processes.
+# The gated latch at one iteration per step, its inputs moved in 60 ms: 42 of its 66 steps (3 of
+# them on the way to a piece's start) break a joint; at two, 4 do. (At the default 80 ms every
+# re-run piece passes at two since the MEMORY's lever rests on its stops without kicking: no
+# piece that still fails.) It runs in about 3 s on two processes.
+MOVE = 0.06
 
 def _step(entry: dict) -> tuple:
     """A step's identity in a sequential report: walk, step, place on the way to a piece's
@@ -310,7 +313,7 @@ def latch():
 
 def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
     design, spec = latch
-    st = dyn_settings(design, LIB, iterations=1)
+    st = dyn_settings(design, LIB, iterations=1, move_time=MOVE)
     seen: list[tuple[int, int]] = []
     on = prove_sequential_dynamic(design, spec, LIB, st, jobs=2,
                                   progress=lambda d, t: seen.append((d, t)))
@@ -328,7 +331,8 @@ def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
     # an independent proof at two iterations runs the same pieces: a piece with no failing
     # step there is proved, and every failure of it leaves the report
     truth = _step_kinds(prove_sequential_dynamic(
-        design, spec, LIB, dyn_settings(design, LIB, iterations=2), jobs=2, recheck=False))
+        design, spec, LIB, dyn_settings(design, LIB, iterations=2, move_time=MOVE), jobs=2,
+        recheck=False))
     whole = [p for p in chosen if not any(_in_piece(k, p) for k in truth)]
     assert 0 < len(whole) < len(chosen)  # both kinds of piece, for real
     proved = {k for k in rechecked if any(_in_piece(k, p) for p in whole)}
@@ -371,7 +375,7 @@ def test_sequential_failing_pieces_rerun_at_twice_the_iterations(latch):
 @pytest.mark.parametrize("recheck", [True, False])
 def test_the_sequential_screened_level_passes_the_setting_on(latch, recheck):
     design, spec = latch
-    r = prove(design, spec, LIB, "screened", ProofSettings(iterations=1, jobs=2,
+    r = prove(design, spec, LIB, "screened", ProofSettings(iterations=1, jobs=2, move_time=MOVE,
                                                            recheck=recheck))
     assert not r.passed and r.figures["screen"]["applied"] is False
     assert ("recheck" in r.figures) == recheck

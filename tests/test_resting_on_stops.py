@@ -1,10 +1,11 @@
-"""An AMPLIFIER at rest stays at rest. pymunk corrects a stop's overrun towards
+"""An AMPLIFIER or a MEMORY at rest stays at rest. pymunk corrects a stop's overrun towards
 none at all, and a slide joint acts only past its limit: a toggle its spring presses onto a
 stop ended, by rounding, a hair outside it, the stop let go for a step, and the spring's whole
 torque kicked the toggle (about 5 rad/s, its output 0.04 mm) every 75-300 ms. In the 16-bit
 adder those kicks, passed on through the gates, kept held outputs off their closed form by up
 to 0.011 of the stroke, so no change ever settled before the end of its hold. Stops held with
-a slop (:func:`mechc.parts.contact.hold_with_slop`) rest a hair in instead."""
+a slop (:func:`mechc.parts.contact.hold_with_slop`) rest a hair in instead. A MEMORY's lever,
+thrown onto its stops by its detent and held there the same way, kicked alike."""
 
 from __future__ import annotations
 
@@ -14,9 +15,11 @@ import pytest
 
 from mechc.bench.circuits import adder2_spec
 from mechc.cells.library import load_library
+from mechc.frontends.fsm import parse_fsm_file
 from mechc.parts.contact import FAR, SLOP, hold_with_slop
 from mechc.physics.scene import DynSettings, Scene
-from mechc.pipeline import compile_spec
+from mechc.pipeline import compile_sequential, compile_spec
+from tests.helpers import EXAMPLES
 
 LIB = load_library()
 
@@ -45,6 +48,27 @@ def test_held_toggles_do_not_kick(adder2, state):
         sc.space.step(st.dt)
         if step * st.dt > 0.05:
             fast += sum(abs(t.angular_velocity) > 1.0 for t in toggles)
+    assert fast == 0
+
+
+def test_held_memory_levers_do_not_kick():
+    """The speed controller's two MEMORY cells a second at rest from power-up: after the first
+    50 ms no part of either moves faster than 30 mm/s (a lever's turn at 30 mm). Before their
+    stops held with a slop, one lever (and its output) passed that in 11 steps of the second."""
+    d = compile_sequential(parse_fsm_file(EXAMPLES / "speedctl.fsm"))
+    mems = {c.id for c in d.netlist.cells.values() if c.type == "MEMORY"}
+    assert len(mems) == 2
+    st = DynSettings()
+    types = {c.id: c.cell for c in d.netlist.cells.values()}
+    sc = Scene.build(d.mechanism, LIB, types, st, dict.fromkeys(d.mechanism.inputs, 0.0))
+    parts = [b for bid, b in sc.bodies.items()
+             if bid.split(".")[0] in mems and b.body_type == pymunk.Body.DYNAMIC]
+    fast = 0
+    for step in range(int(1.0 / st.dt)):
+        sc.space.step(st.dt)
+        if step * st.dt > 0.05:
+            fast += sum(b.velocity.length + 30.0 * abs(b.angular_velocity) > 30.0
+                        for b in parts)
     assert fast == 0
 
 
