@@ -1,7 +1,7 @@
 """An AMPLIFIER or a MEMORY at rest stays at rest. pymunk corrects a stop's overrun towards
 none at all, and a slide joint acts only past its limit: a toggle its spring presses onto a
 stop ended, by rounding, a hair outside it, the stop let go for a step, and the spring's whole
-torque kicked the toggle (about 5 rad/s, its output 0.04 mm) every 75-300 ms. In the 16-bit
+torque kicked the toggle (about 5 rad/s, its output 0.04 mm) every 70-380 ms. In the 16-bit
 adder those kicks, passed on through the gates, kept held outputs off their closed form by up
 to 0.011 of the stroke, so no change ever settled before the end of its hold. Stops held with
 a slop (:func:`mechc.parts.contact.hold_with_slop`) rest a hair in instead. A MEMORY's lever,

@@ -87,7 +87,7 @@ def hold_with_slop(space: pymunk.Space, stop: pymunk.SlideJoint,
     all: a body a spring presses onto the stop ends, by rounding, a hair outside it, and for
     that step the joint lets go and the spring's whole force moves the body. Where the spring
     is strong against the body's inertia, that is a kick (the amplifier's toggle, below 0.1 mm
-    at its output, every 75-300 ms: the 16-bit adder never came to rest). As Chipmunk's own
+    at its output, every 70-380 ms: the 16-bit adder never came to rest). As Chipmunk's own
     contacts do with their collision slop, the stop now holds without correcting its
     overrun, and a second joint ``SLOP`` further in corrects (at ``error_bias``, default the
     stop's) only what lies beyond: the body rests up to ``SLOP`` in, and nothing draws it
