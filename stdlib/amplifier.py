@@ -45,7 +45,7 @@ from mechc.cells.springs import design_coil
 from mechc.errors import DesignError
 from mechc.ir.check import Check
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Part, Point, Spring, SynthContext
-from mechc.parts.contact import hold_with_slop
+from mechc.parts.contact import stiff_stops
 from mechc.parts.lever import Lever
 from mechc.physics.closed_form import solve
 from mechc.physics.scene import FAR, N
@@ -278,7 +278,6 @@ def _disc(c: Point, r: float, n: int = 16) -> list[Point]:
             for a in np.linspace(0, 2 * math.pi, n, endpoint=False)]
 
 
-STOP_ERROR_BIAS = 0.1 ** 60  # pymunk: fraction of a joint error left after 1 s
 #: The wedge clutch's torque limit as a multiple of the torque T must hold on a stop. It stands
 #: for the roller drive's stall torque (a self-locking wedge has no friction limit of its own):
 #: enough to bring T and its loads to the roller speed within a millisecond or so, finite so an
@@ -522,17 +521,10 @@ class Amplifier(Cell):
         for j, shapes in scene.touches:
             if j.id in mine:
                 shapes[-1].friction = 1.0
-        # T lands on its stop at speed: correct the overrun within milliseconds, not pymunk's
-        # default 1/6 s (a slow creep back reads as an output that has not settled)
+        # T lands on its stop at speed, and its spring holds it there
         toggle = next(b.id for b in part.bodies if b.role == "output toggle")
         tb = scene.bodies[toggle]
-        for c in scene.space.constraints:
-            if tb in (c.a, c.b):
-                c.error_bias = STOP_ERROR_BIAS
-        # ... and hold it there: corrected to the edge, a stop let the toggle spring kick T
-        for c in list(scene.space.constraints):
-            if isinstance(c, pymunk.SlideJoint) and tb in (c.a, c.b):  # its stops (contacts)
-                hold_with_slop(scene.space, c)
+        stiff_stops(scene.space, tb)
         _add_wedge_clutches(scene, part, toggle)
         c = part.data["design"].get("dashpot", 0.0)
         if c > 0.0:

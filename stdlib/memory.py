@@ -17,13 +17,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pymunk
 
 from mechc.cells.builder import Builder, rect
 from mechc.cells.cell import Cell
 from mechc.cells.springs import design_coil
 from mechc.ir.mechanism import GROUND, Body, Demand, Joint, Spring
-from mechc.parts.contact import hold_with_slop
+from mechc.parts.contact import stiff_stops
 from mechc.parts.lever import Lever
 from mechc.parts.rod import slider_from_rod
 from mechc.physics.closed_form import KinematicsError, Poses
@@ -195,23 +194,11 @@ class Memory(Cell):
         return poses
 
 
-#: pymunk: fraction of a joint error left after 1 s, for the lever's stops and their touches.
-STOP_ERROR_BIAS = 0.1 ** 60
-
-
 def _stiff_stops(scene, part) -> None:
-    """The lever lands on a stop at speed when the detent throws it: correct the overrun
-    within milliseconds, not pymunk's default 1/6 s (a slow creep back off the stop reads as
-    an output that has not settled, or one past its end)."""
+    """The lever lands on a stop at speed when the detent throws it, and the detent holds it
+    there (:func:`mechc.parts.contact.stiff_stops`)."""
     lever = next(bd.id for bd in part.bodies if bd.kind == "lever")
-    lb = scene.bodies[lever]
-    for c in scene.space.constraints:
-        if lb in (c.a, c.b):
-            c.error_bias = STOP_ERROR_BIAS
-    # ... and hold it there: corrected to the edge, a stop let the detent kick the lever
-    for c in list(scene.space.constraints):
-        if isinstance(c, pymunk.SlideJoint) and lb in (c.a, c.b):  # its stops (contacts)
-            hold_with_slop(scene.space, c)
+    stiff_stops(scene.space, scene.bodies[lever])
 
 
 def _stop(b: Builder, lever: str, at, point, nx: float) -> Joint:

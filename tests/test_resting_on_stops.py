@@ -4,7 +4,7 @@ stop ended, by rounding, a hair outside it, the stop let go for a step, and the 
 torque kicked the toggle (about 5 rad/s, its output 0.04 mm) every 70-380 ms. In the 16-bit
 adder those kicks, passed on through the gates, kept held outputs off their closed form by up
 to 0.011 of the stroke, so no change ever settled before the end of its hold. Stops held with
-a slop (:func:`mechc.parts.contact.hold_with_slop`) rest a hair in instead. A MEMORY's lever,
+a slop (:func:`mechc.parts.contact.stiff_stops`) rest a hair in instead. A MEMORY's lever,
 thrown onto its stops by its detent and held there the same way, kicked alike."""
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import pytest
 from mechc.bench.circuits import adder2_spec
 from mechc.cells.library import load_library
 from mechc.frontends.fsm import parse_fsm_file
-from mechc.parts.contact import FAR, SLOP, hold_with_slop
+from mechc.parts.contact import FAR, SLOP, stiff_stops
 from mechc.physics.scene import DynSettings, Scene
 from mechc.pipeline import compile_sequential, compile_spec
 from tests.helpers import EXAMPLES
@@ -72,12 +72,10 @@ def test_held_memory_levers_do_not_kick():
     assert fast == 0
 
 
-def _pressed_body(x0: float, force: float, slop: bool) -> tuple[int, float]:
-    """A 20 g body a constant ``force`` (N, pymunk units) presses onto a contact at ``x0``
-    (mm), the amplifier's error bias on the stop, one second: the steps it moved faster than
-    1 mm/s after the first 50 ms, and how far in it rests."""
-    from mechc.stdlib.amplifier import STOP_ERROR_BIAS
-
+def _pressed_body(x0: float, force: float) -> tuple[int, float]:
+    """A 20 g body on a groove, a constant ``force`` (N, pymunk units) pressing it onto a
+    contact at ``x0`` (mm), its stops made stiff as the amplifier's toggle, one second: the
+    steps it moved faster than 1 mm/s after the first 50 ms, and how far in it rests."""
     dt = 2.5e-4
     sp = pymunk.Space()
     sp.iterations = 60
@@ -87,10 +85,8 @@ def _pressed_body(x0: float, force: float, slop: bool) -> tuple[int, float]:
                                     (x0 + 100.0, 0.0), (0.0, 0.0)))
     stop = pymunk.SlideJoint(sp.static_body, body, (x0 + FAR, 0.0), (0.0, 0.0), FAR,
                              FAR + 1000.0)  # as mechc.parts.contact builds a stop
-    stop.error_bias = STOP_ERROR_BIAS
     sp.add(stop)
-    if slop:
-        hold_with_slop(sp, stop)
+    stiff_stops(sp, body)
     kicks = 0
     for i in range(int(1.0 / dt)):
         body.apply_force_at_local_point((force, 0.0))
@@ -104,6 +100,6 @@ def test_a_stop_held_with_a_slop_never_lets_go():
     stop held with a slop never lets the body go, and holds it in by at most ``SLOP``."""
     for x0 in np.linspace(0.0, 2000.0, 9):
         for force in (200.0, 2000.0):
-            kicks, rest = _pressed_body(float(x0), force, slop=True)
+            kicks, rest = _pressed_body(float(x0), force)
             assert kicks == 0, (x0, force)
             assert 0.0 < rest <= SLOP * 1.001, (x0, force, rest)

@@ -144,9 +144,9 @@ def compile_path(spec_path: str, args: argparse.Namespace, mechanism: bool = Tru
     if not mechanism and getattr(spec, "kind", "") == "fsm":
         return compile_sequential(spec, options_from_args(args), mechanism=False)
     opts = options_from_args(args)
-    if not getattr(args, "levels", None):  # the file compiled decides, whichever command
-        #                                       (simulate's --spec names another file); too
-        #  wide for a table, multi-level is the one way to build it
+    if not getattr(args, "levels", None):
+        # the file compiled decides, whichever command (simulate's --spec names another
+        # file); a network too wide for a table has one way to be built: multi-level
         opts.levels = ("multi" if getattr(spec, "network", None) is not None
                        else default_levels(spec_path))
     if stages is None:

@@ -75,27 +75,33 @@ class Contact(JointKind):
         scene.space.add(c)
 
 
-#: mm: how far in a stop given :func:`hold_with_slop` may leave its body at rest.
+#: pymunk: the fraction of a joint's error left after 1 s, for a body that lands on its stops at
+#: speed (an amplifier's toggle, a memory's lever): corrected within milliseconds, not pymunk's
+#: default 1/6 s (a slow creep back off the stop reads as an output that has not settled).
+STOP_ERROR_BIAS = 0.1 ** 60
+#: mm: how far in a stop held by :func:`stiff_stops` may leave its body at rest.
 SLOP = 1e-3
 
 
-def hold_with_slop(space: pymunk.Space, stop: pymunk.SlideJoint,
-                   error_bias: float | None = None) -> pymunk.SlideJoint:
-    """Make a contact's slide joint hold a body pressed onto it without chatter.
+def stiff_stops(space: pymunk.Space, body: pymunk.Body) -> None:
+    """Correct every joint error of ``body`` fast (``STOP_ERROR_BIAS``), and hold it on its
+    stops without chatter.
 
-    A slide joint acts only past its limit, and pymunk corrects an overrun towards none at
-    all: a body a spring presses onto the stop ends, by rounding, a hair outside it, and for
+    A slide joint acts only past its limit, and a fast correction takes an overrun towards none
+    at all: a body a spring presses onto the stop ends, by rounding, a hair outside it, and for
     that step the joint lets go and the spring's whole force moves the body. Where the spring
     is strong against the body's inertia, that is a kick (the amplifier's toggle, below 0.1 mm
     at its output, every 70-380 ms: the 16-bit adder never came to rest). As Chipmunk's own
-    contacts do with their collision slop, the stop now holds without correcting its
-    overrun, and a second joint ``SLOP`` further in corrects (at ``error_bias``, default the
-    stop's) only what lies beyond: the body rests up to ``SLOP`` in, and nothing draws it
-    to the edge. Returns the second joint (added to ``space``)."""
-    corrector = pymunk.SlideJoint(stop.a, stop.b, stop.anchor_a, stop.anchor_b,
-                                  stop.min - SLOP, stop.max)
-    corrector.error_bias = stop.error_bias if error_bias is None else error_bias
-    corrector.max_bias = stop.max_bias
-    stop.error_bias = 1.0  # pymunk: the whole error left after a second, i.e. not corrected
-    space.add(corrector)
-    return corrector
+    contacts do with their collision slop, each stop (a contact's slide joint) holds without
+    correcting its overrun, and a second joint ``SLOP`` further in corrects only what lies
+    beyond: the body rests up to ``SLOP`` in, and nothing draws it to the edge."""
+    for c in list(space.constraints):
+        if body not in (c.a, c.b):
+            continue
+        c.error_bias = STOP_ERROR_BIAS
+        if isinstance(c, pymunk.SlideJoint):  # a stop: only contacts are slide joints
+            corrector = pymunk.SlideJoint(c.a, c.b, c.anchor_a, c.anchor_b, c.min - SLOP, c.max)
+            corrector.error_bias = STOP_ERROR_BIAS
+            corrector.max_bias = c.max_bias
+            c.error_bias = 1.0  # pymunk: the whole error left after a second: not corrected
+            space.add(corrector)

@@ -257,8 +257,7 @@ def prove_screened(design: Design, spec: Spec, lib: Library, settings: ProofSett
                          done_before=len(run) + tried)
     cleared = len(pairs) - len(run)
     # the cleared changes a witness run finer vouches for are cleared at its setting
-    keys_finer = [{"change": w["change"]} for w in finer]
-    at_finer = sorted({i for f in keys_finer for i in concerned(f, decisions, keys)})
+    at_finer = sorted({i for w in finer for i in concerned(w, decisions, keys)})
     for i in at_finer:
         decisions[i]["witness_iterations"] = 2 * st.iterations
     text = (f"screen: {len(run)} of {len(pairs)} changes ran in pymunk, {cleared} cleared by "
