@@ -81,8 +81,10 @@ Exit status 0 only if the proof holds; 1 if it fails (the failures are listed)."
                    "stretch, contact overrun or late settle again at twice the iterations "
                    f"(by default the first {RECHECK_MAX} are: one that passes every check "
                    "there failed by the solver and is proved there, counted as passed; one "
-                   "that still fails is listed as failing. Each costs about twice a change "
-                   "at the proof's settings)")
+                   "that still fails is listed as failing; the screened level also re-runs "
+                   "a witness that failed its calibration on stretch or overrun alone, and "
+                   "clears on it there. Each costs about twice a change at the proof's "
+                   "settings)")
     s.add_argument("--prune", action="store_true",
                    help="dynamic: run each input change on a scene of only the cells it can "
                    "move (see docs/performance.md)")
