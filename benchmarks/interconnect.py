@@ -1,6 +1,6 @@
 """Interconnect figures of every example: rods, planes used, total rod length, bends.
 
-    python benchmarks/interconnect.py [--markdown]
+    python benchmarks/interconnect.py [--markdown] [--random SEED:CELLS ...]
 
 Compiles each spec in ``examples/`` with the default options and reads the figures back from
 its design JSON (not from the compiler's own ``stats``, so the table also recomputes them):
@@ -8,6 +8,12 @@ planes are the distinct values of every body's ``layer`` and ``poly_layers`` (ce
 sliders, the nets' fan-out bars and rods); rod length is pin to pin, summed over every rod of
 every net (a ``pushrod`` body between its two pins, or a massless ``rod`` joint as designs
 before rods were bodies held them); bends count the rods' corners (every rod is straight).
+
+Then, for compiled random specs (``mechc.bench.circuits.random_compiled``; default the
+benchmarks' 81-cell circuit, seed 100), how wide the channels made the mechanism: fan-out slots
+per channel, the cells' width, the mass of all rods, and the heaviest load a gate drives
+(``mechc.parts.pushrod.net_loads``: its rods and its loads' input sliders) against
+``HEAVY_KG``, above which the screened proof runs a change in pymunk.
 """
 
 from __future__ import annotations
@@ -17,8 +23,12 @@ import math
 from pathlib import Path
 
 from mechc.backends.design_json import design_to_json
+from mechc.bench.circuits import random_compiled
 from mechc.frontends import load_spec
+from mechc.ir.design import Design
+from mechc.parts.pushrod import net_loads
 from mechc.pipeline import compile_spec
+from mechc.proofs.screen import HEAVY_KG
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SUFFIXES = (".bool", ".pla", ".blif", ".fsm", ".kiss2")
@@ -44,9 +54,32 @@ def figures(obj: dict) -> dict:
             "bends": 0}
 
 
+def channel_figures(d: Design) -> dict:
+    """Fan-out slots per channel (distinct bar positions after each column), the cells' width
+    (mm), every rod's mass (kg) and the loads gates drive (kg)."""
+    mech, nl = d.mechanism, d.netlist
+    depth = nl.depth()
+    slots: dict[int, set[float]] = {}
+    for net, part in mech.nets.items():
+        col = 0 if net in nl.inputs else depth[nl.driver[net][0]]
+        slots.setdefault(col, set()).add(part.data["fanout_bar_x"])
+    xs = [x for p in mech.cells.values() for b in p.bodies for poly in b.outline
+          for x, _ in poly]
+    loads = net_loads(mech)
+    gates = [loads[n] for n in mech.nets if n not in nl.inputs]
+    return {"cells": len(nl.cells), "slots": [len(slots[k]) for k in sorted(slots)],
+            "width_mm": max(xs) - min(xs),
+            "rod_kg": sum(b.mass for p in mech.nets.values() for b in p.bodies),
+            "heaviest_kg": max(gates, default=0.0),
+            "heavy_gates": sum(m > HEAVY_KG for m in gates)}
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    ap.add_argument("--random", action="append", metavar="SEED:CELLS",
+                    help="a compiled random spec of about CELLS cells (repeatable; default "
+                    "100:100, the benchmarks' 81-cell circuit)")
     args = ap.parse_args()
     rows = []
     for path in sorted(p for p in EXAMPLES.iterdir() if p.suffix in SUFFIXES):
@@ -62,11 +95,18 @@ def main() -> None:
         for row in lines:
             print("| " + " | ".join(row) + " |")
         print(f"| total | {sum(f['rods'] for _, f in rows)} | | | {total:.0f} | 0 |")
-        return
-    widths = [max(len(r[i]) for r in [*lines, list(head)]) for i in range(len(head))]
-    for row in [list(head), *lines]:
-        print("  ".join(c.ljust(w) for c, w in zip(row, widths)))
-    print(f"total rod length {total:.0f} mm")
+    else:
+        widths = [max(len(r[i]) for r in [*lines, list(head)]) for i in range(len(head))]
+        for row in [list(head), *lines]:
+            print("  ".join(c.ljust(w) for c, w in zip(row, widths)))
+        print(f"total rod length {total:.0f} mm")
+    for arg in args.random or ["100:100"]:
+        seed, cells = (int(v) for v in arg.split(":"))
+        f = channel_figures(random_compiled(cells, seed=seed))
+        print(f"\nrandom spec seed {seed} ({f['cells']} cells): fan-out slots per channel "
+              f"{', '.join(map(str, f['slots']))}; cells {f['width_mm']:.0f} mm wide; rods "
+              f"{f['rod_kg']:.2f} kg; heaviest gate load {f['heaviest_kg']:.4f} kg, "
+              f"{f['heavy_gates']} gate(s) over {HEAVY_KG:g} kg")
 
 
 if __name__ == "__main__":

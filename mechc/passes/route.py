@@ -25,10 +25,11 @@ a channel of k nets whose bars span the column needs k planes (216 on a 6x6 mult
 13,700 cells, its hazards left uncured), and every rod crossing a bar is an edge (18 million).
 So the pieces are also coloured as two families on separate planes: the horizontal pieces
 (rods, and the arms that meet another net's bar) and the vertical bars (each with its arm where
-the arm meets none: one plate, as before). Bars of one channel are a channel apart and never
-meet, and horizontal pieces meet only near their own row, so both graphs stay sparse and their
-colourings small (that multiplier: 14 planes in all, the cells' included). An arm on a plane of
-its own is a plate fastened to its bar where they overlap, as an arm is to its driver's slider.
+the arm meets none: one plate, as before). Bars of one channel are a slot apart or one above
+the other (``assemble._channel_slots``) and never meet, and horizontal pieces meet only near
+their own row, so both graphs stay sparse and their colourings small (that multiplier: 14
+planes in all, the cells' included). An arm on a plane of its own is a plate fastened to its
+bar where they overlap, as an arm is to its driver's slider.
 The one graph of all pieces is still coloured while it is small (``ONE_GRAPH_EDGES``) and kept
 where it needs no more planes, so small designs keep their planes.
 """
