@@ -17,6 +17,7 @@ from mechc.cells import characterise as ch
 from mechc.cells.library import load_library
 from mechc.frontends import load_spec
 from mechc.pipeline import CompileOptions, compile_spec
+from mechc.proofs.screen import SETTLE_MARGIN
 from tests.helpers import EXAMPLES
 
 LIB = load_library()
@@ -35,7 +36,11 @@ def test_the_cells_behind_a_landing_follow_it(adder4):
     amplifiers), every follower's lag behind its latest input is the scene's within 5 ms (it
     was 0.2 ms against 19 ms when a follower behind an amplifier was read from its alone
     table), every cell crosses mid-stroke within 15 % of the scene, and the change's latest
-    settle is within 15 % of the scene's (it was 17.7 % early)."""
+    settle is within 15 % of the latest any switching output comes to rest in the scene (it
+    was 17.7 % early). The dynamic proof's settle, from the closed form, is later still: the
+    outputs pushed after the last amplifier rest up to 0.004 of stroke short of it, on
+    contacts pymunk leaves penetrated and corrects slowly (docs/performance.md), and creep
+    into its band; the screen's settle margin still covers that."""
     got = compare(adder4, LIB)
     assert got.moving == "CI" and got.to == 1
     behind = [r for r in got.rows if r["timed_as"] == "follower" and "input" in r]
@@ -44,7 +49,9 @@ def test_the_cells_behind_a_landing_follow_it(adder4):
         assert r["model_stage_s"] == pytest.approx(r["scene_stage_s"], abs=0.005), r
     for r in got.rows:
         assert r["model_cross_s"] == pytest.approx(r["scene_cross_s"], rel=0.15), r
-    assert got.predicted_settle_s == pytest.approx(got.scene_settle_s, rel=0.15)
+    at_rest = max(r["scene_settle_s"] for r in got.rows)
+    assert got.predicted_settle_s == pytest.approx(at_rest, rel=0.15)
+    assert got.scene_settle_s <= got.predicted_settle_s * (1 + SETTLE_MARGIN)
 
 
 def test_an_amplifier_behind_another_is_measured_on_a_moving_input(adder4):

@@ -39,6 +39,11 @@ def sorter(tmp_path_factory):
     return _compile("sorter.bool", tmp_path_factory.mktemp("tol") / "sorter.json")
 
 
+@pytest.fixture(scope="module")
+def full_adder(tmp_path_factory):
+    return _compile("full_adder.bool", tmp_path_factory.mktemp("tol") / "full_adder.json")
+
+
 def test_yield_agrees_with_designs_proven_one_by_one(sorter, tmp_path):
     """The same draws written as design JSON and proven alone by the kinematic proof: pass or
     fail agrees sample by sample, and the pass fraction sits in the run's interval."""
@@ -386,17 +391,18 @@ def test_sequential_pin_play_covers_rods_at_their_play(tmp_path):
     assert min(r0.nominal_margin_mm.values()) > min(r.nominal_margin_mm.values()) + 0.01
 
 
-def test_interference_bound_holds_on_perturbed_designs(sorter):
+def test_interference_bound_holds_on_perturbed_designs(full_adder):
     """The interference bound: for every pair held to a gap at nominal and every sample, the
     gap the interference check measures on that sample's design (its own poses in every
     proof state, its outlines cut larger or smaller) is at least the bound; and a large
-    tolerance puts the pairs closest at nominal at risk."""
+    tolerance puts the pairs closest at nominal at risk (the full adder: the sorter's cells,
+    placed near what they connect to, stay clear of each other at this tolerance)."""
     from mechc.physics.evaluate import evaluate
     from mechc.physics.interference import Interference
     from mechc.tolerance.clearance import Risk
     from mechc.tolerance.montecarlo import nominal_gaps, prepare
 
-    design, lib = _load(sorter)
+    design, lib = _load(full_adder)
     s = ToleranceSettings(tol=0.4, clearance=0.0, spring_tol=0.0, samples=24, seed=5)
     batch, _ = prepare(design, lib, s)
     X = draw(batch.dims, s)

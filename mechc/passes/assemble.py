@@ -3,9 +3,9 @@
 ``Netlist, Layout -> Mechanism``. Steps: a force budget from the outputs back to the inputs
 (each cell's springs are sized for what its output must move, and it reports what it asks of
 its inputs); every cell synthesised at a local origin and placed by column (logic depth) and
-row (the layout's order), columns spaced by their real widths plus a channel of fan-out
-slots (bars one above the other share one);
-primary inputs become sliders driven by bounded-force actuators; every net becomes a fan-out
+row (the layout's order, each cell moved up or down towards what it is joined to), columns
+spaced by their real widths plus a channel of fan-out slots (bars one above the other share
+one); primary inputs become sliders driven by bounded-force actuators; every net becomes a fan-out
 bar on its driver's output slider with one horizontal rod to each load (the rods then work at a
 90° transmission angle in every state).
 """
@@ -130,13 +130,17 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
         b.terminal(name, sig.body, (in_len, y))
         inputs[name] = b.part
 
-    # ---- rows: stacked in the layout's order (heights do not depend on x) -------------------
-    shift_y: dict[str, float] = {}
-    for k in range(1, ncol):
-        y = 0.0
-        for cid in cols[k]:
-            shift_y[cid] = y - sizes[cid][3]
-            y -= (sizes[cid][3] - sizes[cid][1]) + row_gap
+    # ---- rows: heights first (they do not depend on x), each cell near what it connects to --
+    def pin_y(node: str, pin: str) -> float:
+        """A terminal's height in its own part (an input's as placed)."""
+        part = inputs[node[3:]] if node.startswith("in:") else local[node]
+        return _mid(part.terminals[pin])[1]
+
+    links: list[tuple[str, str, str, str, float]] = []  # driver, its pin, load, its pin, weight
+    for net, ls in loads.items():
+        node, pin = (f"in:{net}", net) if net in nl.inputs else nl.driver[net]
+        links += [(node, pin, c, p, 1.0 / len(ls)) for c, p in ls]
+    shift_y = _rows(cols[1:], sizes, row_gap, links, pin_y)
 
     # ---- columns: real widths plus a channel of fan-out slots after each --------------------
     sweep = S / 2 + ctx.overtravel * S  # how far a net's parts move from the design pose
@@ -307,6 +311,73 @@ def _route_nets(gap_nets: dict[int, list[str]], slots: dict[str, int], col_x: li
             part.data["arm_plane"] = plane[f"net.{net}.arm"]
         nets[net] = part
     return nets
+
+
+def _rows(cols: list[list[str]], sizes: dict[str, tuple[float, float, float, float]],
+          gap: float, links: list[tuple[str, str, str, str, float]], pin_y,
+          sweeps: int = 6) -> dict[str, float]:
+    """How far each cell is shifted up or down: stacked in its column's order, a ``gap``
+    apart, each as near as that order allows to the terminals it is joined to.
+
+    A net's fan-out bar runs from its driver's terminal to its loads', and every bar a
+    height crosses takes a slot of the channel (:func:`_channel_slots`), so the bars' lengths
+    set the channels' widths and the rods' lengths. Stacking every column from the top
+    left a short column's cells far from their drivers in a long one. Each sweep (to the
+    right, then back) moves every cell of a column towards the mean of what its links ask
+    (a link of a net with n loads weighs 1/n: a net that spans many rows gains little from
+    one of them), and the column's order and gaps are kept by isotonic regression (pool
+    adjacent violators), the least-squares placement under them. Inputs stay where they
+    are."""
+    shift: dict[str, float] = {}
+    for col in cols:  # the stacked start
+        y = 0.0
+        for cid in col:
+            shift[cid] = y - sizes[cid][3]
+            y -= (sizes[cid][3] - sizes[cid][1]) + gap
+    want: dict[str, list[tuple[float, float, str, str]]] = {}  # cell -> (weight, pin, other)
+    for a, pa, b, pb, wgt in links:
+        want.setdefault(b, []).append((wgt, pb, a, pa))
+        if not a.startswith("in:"):
+            want.setdefault(a, []).append((wgt, pa, b, pb))
+
+    def at(node: str, pin: str) -> float:
+        return pin_y(node, pin) + shift.get(node, 0.0)
+
+    order = list(range(len(cols)))
+    for s in range(sweeps):
+        for k in (order if s % 2 == 0 else order[::-1]):
+            col = cols[k]
+            if not col:
+                continue
+            tops, weights = [], []
+            drop = 0.0  # how far below the column's top this cell's top must at least be
+            for cid in col:
+                ws = want.get(cid, [])
+                tw = sum(w for w, *_ in ws)
+                top = (sum(w * (at(o, op) - pin_y(cid, p)) for w, p, o, op in ws) / tw
+                       if tw else shift[cid]) + sizes[cid][3]
+                tops.append(top + drop)  # in the column's frame: non-increasing
+                weights.append(tw or 1e-9)
+                drop += (sizes[cid][3] - sizes[cid][1]) + gap
+            fitted = _decreasing(tops, weights)
+            drop = 0.0
+            for cid, t in zip(col, fitted):
+                shift[cid] = t - drop - sizes[cid][3]
+                drop += (sizes[cid][3] - sizes[cid][1]) + gap
+    return shift
+
+
+def _decreasing(values: list[float], weights: list[float]) -> list[float]:
+    """The non-increasing sequence nearest ``values`` in weighted least squares (pool
+    adjacent violators)."""
+    blocks: list[list[float]] = []  # [mean, weight, count]
+    for v, w in zip(values, weights):
+        blocks.append([v, w, 1])
+        while len(blocks) > 1 and blocks[-2][0] < blocks[-1][0]:
+            m2, w2, n2 = blocks.pop()
+            m1, w1, n1 = blocks.pop()
+            blocks.append([(m1 * w1 + m2 * w2) / (w1 + w2), w1 + w2, n1 + n2])
+    return [m for m, _, n in blocks for _ in range(int(n))]
 
 
 def _channel_slots(gap_nets: dict[int, list[str]], spans: dict[str, tuple[float, float]],
