@@ -12,6 +12,7 @@ bar on its driver's output slider with one horizontal rod to each load (the rods
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from mechc.cells.builder import Builder, rect
@@ -131,32 +132,31 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
         inputs[name] = b.part
 
     # ---- rows: heights first (they do not depend on x), each cell near what it connects to --
+    def part_of(node: str) -> Part:
+        """A cell at its local origin, or an input as placed."""
+        return inputs[node[3:]] if node.startswith("in:") else local[node]
+
     def pin_y(node: str, pin: str) -> float:
-        """A terminal's height in its own part (an input's as placed)."""
-        part = inputs[node[3:]] if node.startswith("in:") else local[node]
-        return _mid(part.terminals[pin])[1]
+        return _mid(part_of(node).terminals[pin])[1]
+
+    def driver_pin(net: str) -> tuple[str, str]:
+        return (f"in:{net}", net) if net in nl.inputs else nl.driver[net]
 
     links: list[tuple[str, str, str, str, float]] = []  # driver, its pin, load, its pin, weight
     for net, ls in loads.items():
-        node, pin = (f"in:{net}", net) if net in nl.inputs else nl.driver[net]
-        links += [(node, pin, c, p, 1.0 / len(ls)) for c, p in ls]
+        links += [(*driver_pin(net), c, p, 1.0 / len(ls)) for c, p in ls]
     shift_y = _rows(cols[1:], sizes, row_gap, links, pin_y)
 
     # ---- columns: real widths plus a channel of fan-out slots after each --------------------
     sweep = S / 2 + ctx.overtravel * S  # how far a net's parts move from the design pose
 
-    def driver_pin(net: str) -> tuple[str, str]:
-        return (f"in:{net}", net) if net in nl.inputs else nl.driver[net]
-
     def bar_span(net: str) -> tuple[float, float]:
         """The heights a net's fan-out bar covers (from the driver's terminal to every
         load's), grown by how far the driver moves up or down."""
-        ys = []
-        for node, pin in [driver_pin(net), *loads[net]]:
-            part = inputs[node[3:]] if node.startswith("in:") else local[node]
-            ys.append(_mid(part.terminals[pin])[1] + shift_y.get(node, 0.0))
+        ys = [pin_y(node, pin) + shift_y.get(node, 0.0)
+              for node, pin in [driver_pin(net), *loads[net]]]
         node, pin = driver_pin(net)
-        part = inputs[node[3:]] if node.startswith("in:") else local[node]
+        part = part_of(node)
         dy = abs((part.body(part.terminals[pin].body).axis or (1.0, 0.0))[1]) * sweep
         return min(ys) - w / 2 - dy, max(ys) + w / 2 + dy
 
@@ -314,8 +314,8 @@ def _route_nets(gap_nets: dict[int, list[str]], slots: dict[str, int], col_x: li
 
 
 def _rows(cols: list[list[str]], sizes: dict[str, tuple[float, float, float, float]],
-          gap: float, links: list[tuple[str, str, str, str, float]], pin_y,
-          sweeps: int = 6) -> dict[str, float]:
+          gap: float, links: list[tuple[str, str, str, str, float]],
+          pin_y: Callable[[str, str], float], sweeps: int = 6) -> dict[str, float]:
     """How far each cell is shifted up or down: stacked in its column's order, a ``gap``
     apart, each as near as that order allows to the terminals it is joined to.
 
