@@ -179,10 +179,8 @@ def assemble_mechanism(nl: Netlist, layout: Layout, lib: Library,
 
     # ---- nets: fan-out bar on the driver, horizontal rods to the loads ----------------------
     def driver_of(net: str) -> tuple[str, Terminal]:
-        if net in nl.inputs:
-            return f"in:{net}", inputs[net].terminals[net]
-        node, pin = nl.driver[net]
-        return node, placed[node].terminals[pin]
+        node, pin = driver_pin(net)
+        return node, (inputs[net] if node.startswith("in:") else placed[node]).terminals[pin]
 
     nets = _route_nets(gap_nets, slots, col_x, col_w, channel, loads, driver_of, inputs, placed,
                        demand, ctx, opts)
@@ -328,12 +326,13 @@ def _rows(cols: list[list[str]], sizes: dict[str, tuple[float, float, float, flo
     one of them), and the column's order and gaps are kept by isotonic regression (pool
     adjacent violators), the least-squares placement under them. Inputs stay where they
     are."""
-    shift: dict[str, float] = {}
-    for col in cols:  # the stacked start
+    drop: dict[str, float] = {}  # how far below its column's top a cell's top is, stacked
+    for col in cols:
         y = 0.0
         for cid in col:
-            shift[cid] = y - sizes[cid][3]
-            y -= (sizes[cid][3] - sizes[cid][1]) + gap
+            drop[cid] = y
+            y += (sizes[cid][3] - sizes[cid][1]) + gap
+    shift = {cid: -drop[cid] - sizes[cid][3] for cid in drop}  # the stacked start
     want: dict[str, list[tuple[float, float, str, str]]] = {}  # cell -> (weight, pin, other)
     for a, pa, b, pb, wgt in links:
         want.setdefault(b, []).append((wgt, pb, a, pa))
@@ -350,20 +349,15 @@ def _rows(cols: list[list[str]], sizes: dict[str, tuple[float, float, float, flo
             if not col:
                 continue
             tops, weights = [], []
-            drop = 0.0  # how far below the column's top this cell's top must at least be
             for cid in col:
                 ws = want.get(cid, [])
                 tw = sum(w for w, *_ in ws)
                 top = (sum(w * (at(o, op) - pin_y(cid, p)) for w, p, o, op in ws) / tw
                        if tw else shift[cid]) + sizes[cid][3]
-                tops.append(top + drop)  # in the column's frame: non-increasing
+                tops.append(top + drop[cid])  # in the column's frame: non-increasing
                 weights.append(tw or 1e-9)
-                drop += (sizes[cid][3] - sizes[cid][1]) + gap
-            fitted = _decreasing(tops, weights)
-            drop = 0.0
-            for cid, t in zip(col, fitted):
-                shift[cid] = t - drop - sizes[cid][3]
-                drop += (sizes[cid][3] - sizes[cid][1]) + gap
+            for cid, t in zip(col, _decreasing(tops, weights)):
+                shift[cid] = t - drop[cid] - sizes[cid][3]
     return shift
 
 
@@ -401,11 +395,9 @@ def _channel_slots(gap_nets: dict[int, list[str]], spans: dict[str, tuple[float,
         tops: list[float] = []
         for net in sorted(names, key=lambda n: (spans[n][0], n)):
             lo, hi = spans[net]
-            free = [t for t, top in enumerate(tops) if lo - top >= clearance + 1e-6]
-            if free:
-                t = free[0]
-            else:
-                t = len(tracks)
+            t = next((t for t, top in enumerate(tops) if lo - top >= clearance + 1e-6),
+                     len(tracks))
+            if t == len(tracks):
                 tracks.append([])
                 tops.append(hi)
             tracks[t].append(net)
